@@ -1,0 +1,22 @@
+// Paper d): adjacency of patches and assignment of edge pixels to the nearest patch.
+#pragma once
+
+#include "clutterseg/params.hpp"
+#include "clutterseg/types.hpp"
+
+namespace clutterseg {
+
+using PatchPair = std::pair<int, int>;  // 0-based patch indices, first < second
+
+struct Assignment {
+  cv::Mat labels;                  // CV_32S: patch id (1..N) per pixel, edge pixels included; 0 = none
+  std::vector<PatchPair> adjacent; // every pair of patches seen together by one edge pixel; sorted, unique
+};
+
+// For every edge pixel with a valid point: the patch pixels within `radius_px` in the image whose 3D
+// distance is below d_max; all patches seen become pairwise adjacent and the pixel joins the patch of
+// the nearest such point. One pass; pixels seeing no patch stay 0. radius_px is already scaled.
+Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points, int num_patches,
+                              int radius_px, double d_max);
+
+}  // namespace clutterseg

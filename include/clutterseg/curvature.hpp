@@ -1,0 +1,29 @@
+// Paper h): curvature matching of curved patches by their normal histograms.
+#pragma once
+
+#include "clutterseg/adjacency.hpp"
+
+namespace clutterseg {
+
+// S(A, B) = sum_ij min(a_ij, b_ij), in [0, 1] (paper Eq. 3).
+double histogram_similarity(const std::vector<float>& a, const std::vector<float>& b);
+
+// Convexity of a curved patch from its normal histogram (paper Eq. 4, defined physically: a convex
+// surface's normals turn away from its centre). +1 convex, -1 concave, 0 undecided.
+int convexity(const Patch& patch, const cv::Mat& points, const cv::Mat& normals, int bins);
+
+struct CurvatureLink {
+  PatchPair pair;
+  Cue cue;  // CurvatureOpen or CurvatureOccluded
+};
+
+// Links between curved patches not already in `linked`: similar histograms (S > theta_h) and either
+// image neighbours of opposite convexity (open object), or a 3D line through both patches' peak-bin
+// points that fits within line_fit and passes the occlusion check (occluded curved object).
+std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches,
+                                           const std::vector<PatchPair>& linked,
+                                           const cv::Mat& assigned_labels, const cv::Mat& points,
+                                           const cv::Mat& normals, const Camera& camera,
+                                           const Params& params);
+
+}  // namespace clutterseg

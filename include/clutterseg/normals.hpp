@@ -1,0 +1,26 @@
+// Paper a): organized 3D points and per-pixel surface normals.
+#pragma once
+
+#include "clutterseg/params.hpp"
+#include "clutterseg/types.hpp"
+
+namespace clutterseg {
+
+// Back-projects depth (CV_32F metres, 0 = none) to CV_32FC3 camera-frame points; invalid = (0,0,0).
+cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera);
+
+// Largest |z(q) - z(p)| / z(p) between pixels `step` apart that is not a depth discontinuity.
+float relative_jump_limit(const Params::Edges& params, int step, const Camera& camera);
+
+// Normals (CV_32FC3, unit, facing the camera; (0,0,0) = none) from the cross product of the
+// horizontal and vertical neighbour differences at distance `step`, then a Gaussian of size `ksize`
+// and renormalisation. A difference across a depth discontinuity (jump_limit, relative to z) falls
+// back to the one-sided difference. step and ksize are the resolution-scaled values.
+cv::Mat compute_normals(const cv::Mat& points, int step, int ksize, float jump_limit);
+
+// Resolution-scaled kernel sizes for an image of the given width.
+int scaled_normal_step(const Params::Normals& params, int width);
+int scaled_edge_step(const Params::Edges& params, int width);
+int scaled_smooth_ksize(const Params::Normals& params, int width);
+
+}  // namespace clutterseg

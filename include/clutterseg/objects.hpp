@@ -1,0 +1,26 @@
+// Per-object outputs: statistics, support plane and the objects-only view.
+#pragma once
+
+#include <optional>
+
+#include "clutterseg/params.hpp"
+#include "clutterseg/types.hpp"
+
+namespace clutterseg {
+
+// Pixel count, centroid and PCA-oriented box per object (transformed by camera.camera_to_robot),
+// its patches and cut cost. object_labels is CV_32S 1..M.
+std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat& points,
+                                     const std::vector<int>& object_of_patch,
+                                     const std::vector<float>& cut_cost, const Camera& camera);
+
+// The table: the large flat patch with the most object mass resting on its camera-facing side.
+// Marks objects[i].support / .background and returns the plane (camera frame) if one is found.
+std::optional<Plane> find_support(std::vector<Object>& objects, const std::vector<Patch>& patches,
+                                  const cv::Mat& object_labels, const cv::Mat& points,
+                                  const Params::Support& params);
+
+// Copy of object_labels with support and background objects set to 0 and the rest renumbered 1..K.
+cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects);
+
+}  // namespace clutterseg

@@ -1,0 +1,106 @@
+// All tunable values of clutterseg, one struct per stage of the paper (Ückermann et al., IROS 2013,
+// Sec. II). Every default is in physical or scale-free units so that it works on any depth sensor and
+// resolution; pixel sizes are given for 320x240 (the paper's resolution) and scaled with the image width.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace clutterseg {
+
+struct Params {
+  // a) Depth smoothing.
+  struct Smoothing {
+    bool median = true;          // 3x3 median on depth, invalid pixels ignored and kept invalid
+    bool temporal = true;        // motion-sensitive temporal smoothing (Segmenter only; stateful)
+    int temporal_frames = 6;     // n: window length [frames]
+    double temporal_band = 0.003;  // k [1/m]: values within k*z^2 of the newest are averaged
+                                   // (Kinect v1: 10 raw disparity units ~ 3 mm at 1 m, grows with z^2)
+  } smoothing;
+
+  // a) Normals by cross product of image neighbours on the organized 3D points, then Gaussian-smoothed.
+  struct Normals {
+    int step_px = 1;             // neighbour distance at 320x240 [px]; scaled with resolution
+    int smooth_ksize = 5;        // Gaussian kernel at 320x240 [px, odd]; scaled with resolution
+  } normals;
+
+  // b) Normal edges.
+  struct Edges {
+    double theta = 0.85;         // pixel is an edge when mean_q |n(p).n(q)| over 8 neighbours < theta
+    int step_px = 2;             // distance of the 8 neighbours at 320x240 [px]; scaled with resolution
+    double jump_slope = 10;      // depth discontinuity: |z(p) - z(q)| > jump_slope * lateral distance
+                                 // of the two pixels (a surface steeper than ~84 deg to the view ray)
+  } edges;
+
+  // c) Surface patches = 4-connected components of non-edge pixels.
+  struct Patches {
+    int min_size_px = 50;        // smallest patch at 320x240 [px]; scaled with image area
+    int histogram_bins = 11;     // normal (x, y) histogram bins per axis
+    double occupied_share = 0.005;  // a histogram bin counts as occupied above this share [-]
+    int flat_max_bins = 8;       // a patch is flat when fewer bins than this are occupied
+  } patches;
+
+  // d) Adjacency and assignment of edge pixels to the nearest patch.
+  struct Adjacency {
+    double radius_px = 7;        // image search radius at 320x240 [px]; scaled with resolution
+    double d_max = 0.015;        // largest 3D distance to a patch pixel [m]
+  } adjacency;
+
+  // e) Cut-free neighbours (RANSAC planes of one patch must not cut the other).
+  struct CutFree {
+    bool enabled = true;
+    int planes = 20;             // RANSAC planes per patch and direction
+    double band = 0.008;         // points within +-band of a plane count as on it [m]
+    double wrong_side_fraction = 0.1;  // a plane cuts when more than this share lies on its minority side
+    double skip_angle_deg = 30;  // pairs with mean normals closer than this skip the test (the authors' choice)
+    bool skip_similar = true;    // set false to always test
+  } cutfree;
+
+  // f/g) Co-planarity of flat, non-adjacent patches separated by occlusion.
+  struct Coplanarity {
+    bool enabled = true;
+    double angle_deg = 30;       // mean normals and sampled triple normals within this angle
+    int triples = 50;            // random point triples spanning both patches
+    int lines = 9;               // random lines for the occlusion check
+    double behind_fraction = 0.05;  // a line fails when more samples than this lie behind the 3D segment
+    double behind_tolerance = 0.01;  // a sample is behind when deeper than the segment by this [m]
+    double lines_pass = 0.8;     // share of lines that must pass
+    double max_gap = 0.3;        // patches farther apart than this are never joined [m]
+  } coplanarity;
+
+  // h) Curvature matching of curved patches (normal histograms).
+  struct Curvature {
+    bool enabled = true;
+    double theta_h = 0.5;        // similarity S = sum min(a, b) must exceed this
+    bool open_objects = true;    // inner/outer walls of cups and bowls (convex next to concave)
+    bool occluded = true;        // curved patches split by an occluder (line through peak-bin points)
+    double line_fit = 0.01;      // RMS distance of peak-bin points to their fitted 3D line [m]
+    double neighbour_gap_px = 7; // open-object patches are image neighbours within this at 320x240 [px]
+  } curvature;
+
+  // i) Graph cut on the patch graph: w_ij = 1/deg(i), symmetrised.
+  struct GraphCut {
+    double theta_c = 0.5;        // split a component while a cut cheaper than this exists
+  } graph;
+
+  // j) Remaining (unassigned) pixels.
+  struct Remaining {
+    double grow_distance = 0.01; // 8-connected Euclidean region growing [m]
+    int tiny_px = 20;            // "very few points" at 320x240 [px]; scaled with image area
+  } remaining;
+
+  // Support plane (table) detection for the objects-only view.
+  struct Support {
+    bool objects_only = false;   // label 0 for the support plane and background surfaces
+    double plane_band = 0.015;   // pixels within this of the table plane belong to it [m]
+    double max_height = 0.5;     // objects higher above the table than this are background [m]
+  } support;
+
+  std::uint64_t seed = 1;        // every random choice is seeded from this
+  int threads = 0;               // 0 = all cores (OpenMP); results do not depend on it
+};
+
+// Resolution scale factor relative to the paper's 320x240.
+inline double resolution_scale(int width) { return width / 320.0; }
+
+}  // namespace clutterseg

@@ -1,0 +1,24 @@
+// Paper c): surface patches = connected components of non-edge pixels, with per-patch statistics.
+#pragma once
+
+#include "clutterseg/params.hpp"
+#include "clutterseg/types.hpp"
+
+namespace clutterseg {
+
+struct Patches {
+  cv::Mat labels;              // CV_32S, patch id 1..N, 0 = edge or dropped
+  std::vector<Patch> patches;  // patches[i].id == i + 1
+};
+
+// 4-connected components of the non-edge pixels; components smaller than min_size (already scaled
+// to the resolution) are dropped. Statistics per patch from points and normals.
+Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::Mat& normals,
+                        const Params::Patches& params, int min_size);
+
+// Normal (x, y) histogram of the given pixels: bins x bins shares summing to 1.
+std::vector<float> normal_histogram(const cv::Mat& normals, const std::vector<int>& pixels, int bins);
+
+int scaled_min_patch_size(const Params::Patches& params, int width);
+
+}  // namespace clutterseg

@@ -1,0 +1,51 @@
+// The public entry point: depth image + intrinsics in, object hypotheses out.
+#pragma once
+
+#include <optional>
+
+#include "clutterseg/params.hpp"
+#include "clutterseg/patches.hpp"
+#include "clutterseg/smoothing.hpp"
+#include "clutterseg/types.hpp"
+
+namespace clutterseg {
+
+struct Result {
+  cv::Mat object_labels;          // CV_32S, object id 1..M, 0 = nothing
+  cv::Mat patch_labels;           // CV_32S, patch id 1..N after edge-pixel assignment, 0 = none
+  std::vector<Patch> patches;     // statistics per patch (core pixels)
+  std::vector<GraphEdge> graph;   // weighted patch graph with the cue of each link
+  std::vector<Object> objects;    // objects[i].id == i + 1
+  std::optional<Plane> support_plane;  // the table, camera frame
+  Timings timings_ms;             // per stage, last entry "total"
+
+  // Intermediate images, for debugging and the debug views.
+  cv::Mat depth;        // CV_32F metres after smoothing, 0 = none
+  cv::Mat points;       // CV_32FC3 camera frame
+  cv::Mat normals;      // CV_32FC3 unit, (0,0,0) = none
+  cv::Mat edge_value;   // CV_32F mean |n.n_q|
+  cv::Mat edges;        // CV_8U 255 = edge
+  cv::Mat core_patch_labels;  // CV_32S patches before edge pixels were assigned
+};
+
+// Stateful segmenter: keeps the temporal-smoothing window between frames of a stream.
+class Segmenter {
+ public:
+  explicit Segmenter(Params params = {});
+
+  // depth: CV_16U (times camera.depth_unit_m) or CV_32F metres; 0/NaN = no measurement.
+  // Throws Error when the depth type or intrinsics do not fit.
+  Result segment(const cv::Mat& depth, const Camera& camera);
+
+  void reset() { temporal_.reset(); }
+  const Params& params() const { return params_; }
+
+ private:
+  Params params_;
+  TemporalSmoother temporal_;
+};
+
+// One frame, no temporal history.
+Result segment(const cv::Mat& depth, const Camera& camera, const Params& params = {});
+
+}  // namespace clutterseg

@@ -1,0 +1,31 @@
+// Paper a): depth smoothing. Depth is CV_32F in metres, 0 = no measurement.
+#pragma once
+
+#include <deque>
+
+#include "clutterseg/params.hpp"
+#include "clutterseg/types.hpp"
+
+namespace clutterseg {
+
+// Converts uint16 depth (times camera.depth_unit_m) or float metres (NaN/inf/<=0 = none) to CV_32F
+// metres with 0 = none. Throws Error if the type is neither.
+cv::Mat depth_to_metres(const cv::Mat& depth, const Camera& camera);
+
+// 3x3 median over the valid neighbours of each valid pixel; invalid pixels stay invalid.
+cv::Mat median_depth(const cv::Mat& depth);
+
+// Motion-sensitive temporal smoothing over the last n frames: a pixel becomes the mean of the window's
+// values that lie within band = k * z^2 of its newest value, so static surfaces are averaged and moving
+// ones keep their newest depth (no motion blur). A pixel invalid in the newest frame stays invalid.
+class TemporalSmoother {
+ public:
+  cv::Mat push(const cv::Mat& depth, const Params::Smoothing& params);
+  void reset() { window_.clear(); }
+  int size() const { return static_cast<int>(window_.size()); }
+
+ private:
+  std::deque<cv::Mat> window_;  // newest last
+};
+
+}  // namespace clutterseg

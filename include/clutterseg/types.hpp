@@ -1,0 +1,82 @@
+// Plain data passed between the stages. Images are cv::Mat; label images are CV_32S with 0 = none.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace clutterseg {
+
+// Every failure of the library: a one-line message that names the input and the problem.
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Pinhole intrinsics of the depth image, plus the unit of integer depth.
+struct Camera {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  int width = 0, height = 0;
+  double depth_unit_m = 0.001;  // metres per integer depth step (uint16 input)
+  Eigen::Matrix4d camera_to_robot = Eigen::Matrix4d::Identity();  // pose for 3D outputs
+};
+
+// Checks intrinsics against an image; throws Error("<what>: ...") when they do not fit.
+void check_camera(const Camera& camera, int width, int height, const std::string& what);
+
+// One surface patch (paper c): statistics over its core pixels, before edge pixels are assigned.
+struct Patch {
+  int id = 0;                          // label in the patch image (1..N)
+  std::vector<int> pixels;             // linear indices y * width + x of its core pixels
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();     // camera frame [m]
+  Eigen::Vector3f mean_normal = Eigen::Vector3f::Zero();  // unit, facing the camera
+  float spread_deg = 0;                // mean angle of pixel normals to the mean normal
+  std::vector<float> histogram;        // bins x bins shares of normal (x, y); sums to 1
+  int occupied_bins = 0;               // bins with share >= Params::Patches::occupied_share
+  bool curved = false;                 // occupied_bins >= flat_max_bins
+  cv::Rect bbox;                       // image bounding box
+};
+
+// Why two patches are linked in the graph.
+enum class Cue : std::uint8_t { Adjacent, Coplanar, CurvatureOpen, CurvatureOccluded };
+const char* to_string(Cue cue);
+
+struct GraphEdge {
+  int a = 0, b = 0;    // patch indices (0-based into the patch table), a < b
+  Cue cue = Cue::Adjacent;
+  float weight = 0;    // symmetrised 1/deg weight (paper i)
+};
+
+struct OrientedBox {
+  Eigen::Vector3f center = Eigen::Vector3f::Zero();
+  Eigen::Matrix3f axes = Eigen::Matrix3f::Identity();  // columns: unit axes, largest extent first
+  Eigen::Vector3f extents = Eigen::Vector3f::Zero();    // full side lengths along the axes [m]
+};
+
+struct Plane {
+  Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();  // unit, facing the camera
+  float offset = 0;                                   // normal . x + offset = 0
+  float distance(const Eigen::Vector3f& x) const { return normal.dot(x) + offset; }
+};
+
+struct Object {
+  int id = 0;                     // label in the object image (1..M)
+  int pixel_count = 0;
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();  // robot frame if a pose is given [m]
+  OrientedBox box;                // robot frame if a pose is given
+  std::vector<int> patches;       // patch indices (0-based)
+  float cut_cost = 0;             // cost of the cheapest cut that would split it; +inf for one patch
+  bool support = false;           // the table the objects stand on
+  bool background = false;        // walls and far surfaces
+};
+
+// Per-stage wall-clock times in milliseconds, in pipeline order; the last entry is "total".
+using Timings = std::vector<std::pair<std::string, double>>;
+
+}  // namespace clutterseg

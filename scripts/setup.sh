@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Installs everything clutterseg needs to build, test and benchmark, from Debian 12's packages only.
+# Safe to run again; needs root (or sudo).
+set -euo pipefail
+SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends \
+  build-essential cmake ninja-build pkg-config \
+  libopencv-dev libeigen3-dev libcli11-dev nlohmann-json3-dev \
+  libgtest-dev libgmock-dev libbenchmark-dev \
+  libpcl-dev \
+  chromium fonts-dejavu-core \
+  python3 python3-numpy python3-matplotlib >/dev/null

@@ -1,0 +1,62 @@
+#include "clutterseg/config.hpp"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "clutterseg/types.hpp"
+
+namespace clutterseg {
+
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Smoothing, median, temporal, temporal_frames, temporal_band)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Normals, step_px, smooth_ksize)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Edges, theta, step_px, jump_slope)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Patches, min_size_px, histogram_bins, occupied_share, flat_max_bins)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Adjacency, radius_px, d_max)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::CutFree, enabled, planes, band, wrong_side_fraction, skip_angle_deg, skip_similar)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Coplanarity, enabled, angle_deg, triples, lines, behind_fraction, behind_tolerance, lines_pass, max_gap)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Curvature, enabled, theta_h, open_objects, occluded, line_fit, neighbour_gap_px)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::GraphCut, theta_c)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Remaining, grow_distance, tiny_px)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Support, objects_only, plane_band, max_height)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params, smoothing, normals, edges, patches, adjacency, cutfree,
+                                                coplanarity, curvature, graph, remaining, support, seed, threads)
+
+namespace {
+// Lists keys of `given` that the defaults do not have (typos would otherwise be ignored silently).
+void check_keys(const nlohmann::json& given, const nlohmann::json& known, const std::string& path,
+                const std::string& what) {
+  for (const auto& [key, value] : given.items()) {
+    if (!known.contains(key)) throw Error(what + ": unknown parameter '" + path + key + "'");
+    if (value.is_object()) check_keys(value, known.at(key), path + key + ".", what);
+  }
+}
+}  // namespace
+
+std::string params_to_json(const Params& params) { return nlohmann::json(params).dump(2); }
+
+Params params_from_json(const std::string& text, const std::string& what) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    throw Error(what + ": is not valid JSON (" + e.what() + ")");
+  }
+  if (!j.is_object()) throw Error(what + ": parameters must be a JSON object");
+  check_keys(j, nlohmann::json(Params{}), "", what);
+  try {
+    return j.get<Params>();
+  } catch (const std::exception& e) {
+    throw Error(what + ": " + e.what());
+  }
+}
+
+Params read_params_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path.string() + ": cannot be opened");
+  std::stringstream text;
+  text << in.rdbuf();
+  return params_from_json(text.str(), path.string());
+}
+
+}  // namespace clutterseg

@@ -1,0 +1,29 @@
+#include "clutterseg/parallel.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace clutterseg {
+
+void set_threads(int threads) {
+#ifdef _OPENMP
+  omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs());
+#else
+  (void)threads;
+#endif
+}
+
+void parallel_for_rows(int rows, const std::function<void(int, int)>& body) {
+  // Blocks of rows amortise the call; the split never changes what each row computes.
+  constexpr int kBlock = 16;
+  const int blocks = (rows + kBlock - 1) / kBlock;
+#pragma omp parallel for schedule(static)
+  for (int b = 0; b < blocks; ++b) {
+    const int begin = b * kBlock;
+    const int end = begin + kBlock < rows ? begin + kBlock : rows;
+    body(begin, end);
+  }
+}
+
+}  // namespace clutterseg
