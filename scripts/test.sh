@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# The test command: installs dependencies (apt), builds, and runs the whole test suite with ctest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+bash scripts/build.sh
+ctest --test-dir build --output-on-failure -j 2

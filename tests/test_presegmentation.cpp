@@ -1,0 +1,118 @@
+// Pre-segmentation (paper a-c) on analytic depth images: what the paper says each stage must do.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "clutterseg/edges.hpp"
+#include "clutterseg/normals.hpp"
+#include "clutterseg/patches.hpp"
+#include "clutterseg/segmenter.hpp"
+#include "clutterseg/smoothing.hpp"
+#include "scenes.hpp"
+
+using namespace clutterseg;
+
+TEST(Median, KeepsInvalidPixelsInvalidAndIgnoresThem) {
+  cv::Mat d(5, 5, CV_32F, cv::Scalar(1.0f));
+  d.at<float>(2, 2) = 0;   // a hole stays a hole
+  d.at<float>(1, 1) = 0;   // a neighbour hole does not drag the median to 0
+  d.at<float>(3, 3) = 5;   // a spike is removed
+  const cv::Mat m = median_depth(d);
+  EXPECT_EQ(m.at<float>(2, 2), 0.f);
+  EXPECT_EQ(m.at<float>(1, 1), 0.f);
+  EXPECT_FLOAT_EQ(m.at<float>(3, 3), 1.f);
+  EXPECT_FLOAT_EQ(m.at<float>(1, 2), 1.f);
+  EXPECT_FLOAT_EQ(m.at<float>(0, 0), 1.f);
+}
+
+TEST(Temporal, AveragesStaticNoiseAndKeepsMotion) {
+  Params::Smoothing p;
+  TemporalSmoother t;
+  cv::RNG rng(1);
+  cv::Mat last;
+  for (int i = 0; i < 6; ++i) {
+    cv::Mat d(20, 20, CV_32F);
+    rng.fill(d, cv::RNG::NORMAL, 1.0, 0.001);  // 1 m, 1 mm noise: inside the 3 mm band
+    last = t.push(d, p);
+  }
+  cv::Scalar mean, sd;
+  cv::meanStdDev(last, mean, sd);
+  EXPECT_LT(sd[0], 0.0007);  // about 1/sqrt(6) of the input noise
+  // A box appears 10 cm in front: the newest depth is taken, not a blend (no motion blur).
+  cv::Mat moved(20, 20, CV_32F, cv::Scalar(0.9f));
+  const cv::Mat out = t.push(moved, p);
+  EXPECT_FLOAT_EQ(out.at<float>(10, 10), 0.9f);
+}
+
+TEST(Normals, PlaneFacingTheCameraAndTiltedPlane) {
+  Camera cam = synth::default_camera(64, 48);
+  cv::Mat flat(48, 64, CV_32F, cv::Scalar(1.0f));
+  cv::Mat n = compute_normals(depth_to_points(flat, cam), 1, 5, 0.1f);
+  cv::Vec3f c = n.at<cv::Vec3f>(24, 32);
+  EXPECT_NEAR(c[2], -1.0, 1e-4);
+  // Plane z = 1 + 0.5 y (tilted about the x axis): normal (0, -0.5, 1) normalised, facing the camera.
+  cv::Mat tilted(48, 64, CV_32F);
+  for (int v = 0; v < 48; ++v)
+    for (int u = 0; u < 64; ++u) {
+      const double ry = (v - cam.cy) / cam.fy;  // z = 1 + 0.5 * ry * z
+      tilted.at<float>(v, u) = static_cast<float>(1.0 / (1.0 - 0.5 * ry));
+    }
+  n = compute_normals(depth_to_points(tilted, cam), 1, 5, 0.1f);
+  c = n.at<cv::Vec3f>(24, 32);
+  const Eigen::Vector3f expected = Eigen::Vector3f(0, 0.5f, -1).normalized();
+  EXPECT_NEAR(c[1], expected.y(), 1e-3);
+  EXPECT_NEAR(c[2], expected.z(), 1e-3);
+}
+
+TEST(Edges, PlaneHasNoEdgesAndAStepHasOne) {
+  Camera cam = synth::default_camera(64, 48);
+  cv::Mat d(48, 64, CV_32F, cv::Scalar(1.0f));
+  Params::Edges pe;
+  auto edges_of = [&](const cv::Mat& depth) {
+    const cv::Mat pts = depth_to_points(depth, cam);
+    const float jump = relative_jump_limit(pe, 1, cam);
+    return edge_mask(normal_edge_value(compute_normals(pts, 1, 5, jump), 1), pts, pe.theta, 1, jump);
+  };
+  EXPECT_EQ(cv::countNonZero(edges_of(d)), 0);
+  d(cv::Rect(32, 0, 32, 48)).setTo(0.8f);  // a 20 cm step
+  const cv::Mat e = edges_of(d);
+  for (int v = 0; v < 48; ++v) EXPECT_TRUE(e.at<uchar>(v, 31) || e.at<uchar>(v, 32)) << "row " << v;
+  EXPECT_EQ(e.at<uchar>(24, 10), 0);
+  EXPECT_EQ(e.at<uchar>(24, 50), 0);
+}
+
+TEST(Patches, BoxOnPlaneGivesTableAndVisibleFaces) {
+  const auto scene = scenes::box_on_plane();
+  const auto truth = scene.render();
+  Params p;
+  p.smoothing.temporal = false;
+  const Result r = segment(truth.depth, scene.camera, p);
+  // Table + top + two visible side faces: each a patch of its own.
+  EXPECT_GE(r.patches.size(), 3u);
+  EXPECT_LE(r.patches.size(), 4u);
+  // No patch mixes box and table pixels.
+  for (const auto& patch : r.patches) {
+    int on_box = 0;
+    for (int i : patch.pixels) on_box += truth.labels.ptr<int>()[i] == 1;
+    EXPECT_TRUE(on_box == 0 || on_box == static_cast<int>(patch.pixels.size())) << "patch " << patch.id;
+  }
+  for (const auto& patch : r.patches) EXPECT_FALSE(patch.curved) << "patch " << patch.id;
+}
+
+TEST(Patches, SmallComponentsAreDropped) {
+  cv::Mat edges(40, 40, CV_8U, cv::Scalar(0));
+  edges.row(20).setTo(255);
+  edges(cv::Rect(0, 0, 5, 5)).setTo(255);
+  edges.at<uchar>(2, 2) = 0;  // a 1-pixel island
+  cv::Mat pts(40, 40, CV_32FC3, cv::Scalar(0, 0, 1)), nrm(40, 40, CV_32FC3, cv::Scalar(0, 0, -1));
+  const Patches p = extract_patches(edges, pts, nrm, Params::Patches{}, 10);
+  EXPECT_EQ(p.patches.size(), 2u);
+  EXPECT_EQ(p.labels.at<int>(2, 2), 0);
+}
+
+TEST(Segmenter, RejectsBadInput) {
+  Camera cam = synth::default_camera(64, 48);
+  EXPECT_THROW(segment(cv::Mat(48, 64, CV_16U, cv::Scalar(0)), cam), Error);      // all invalid
+  EXPECT_THROW(segment(cv::Mat(48, 64, CV_8UC3, cv::Scalar(1)), cam), Error);     // colour
+  EXPECT_THROW(segment(cv::Mat(40, 64, CV_16U, cv::Scalar(1000)), cam), Error);   // size mismatch
+}
