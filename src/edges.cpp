@@ -80,7 +80,7 @@ cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& depth, double theta,
         }
       }
       for (int x = 0; x < cols; ++x)
-        e[x] = (z[x] <= 0 || v[x] < th || big[x] > jump_limit * z[x]) ? 255 : 0;
+        e[x] = static_cast<uchar>(((z[x] <= 0) | (v[x] < th) | (big[x] > jump_limit * z[x])) * 255);
     }
   });
   return edges;

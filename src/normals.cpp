@@ -31,6 +31,40 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
   return static_cast<float>(params.jump_slope * step / std::min(camera.fx, camera.fy));
 }
 
+namespace {
+
+// One row of raw normals. Plain pointers and values (no captures) so that the loop vectorises.
+void raw_normal_row(const float* __restrict up, const float* __restrict mid, const float* __restrict down,
+                    const float* __restrict rx, float ry, float ry_up, float ry_down, int cols, int s,
+                    float jump_limit, float* __restrict nx, float* __restrict ny, float* __restrict nz) {
+  for (int x = 0; x < cols; ++x) {
+    const float z = mid[x], lim = jump_limit * z;
+    const float zl = mid[x - s], zr = mid[x + s], zu = up[x], zd = down[x];
+    // 1 where the neighbour continues the surface, else 0 (arithmetic blends vectorise).
+    const float l = (zl > 0.f) & (std::abs(zl - z) <= lim) ? 1.f : 0.f;
+    const float r = (zr > 0.f) & (std::abs(zr - z) <= lim) ? 1.f : 0.f;
+    const float u = (zu > 0.f) & (std::abs(zu - z) <= lim) ? 1.f : 0.f;
+    const float d = (zd > 0.f) & (std::abs(zd - z) <= lim) ? 1.f : 0.f;
+    const float px = rx[x] * z, py = ry * z;
+    // Horizontal tangent a - b, vertical tangent c - e; a missing neighbour is replaced by the centre.
+    const float ax = px + r * (rx[x + s] * zr - px), ay = py + r * (ry * zr - py), az = z + r * (zr - z);
+    const float bx = px + l * (rx[x - s] * zl - px), by = py + l * (ry * zl - py), bz = z + l * (zl - z);
+    const float cx = px + d * (rx[x] * zd - px), cy = py + d * (ry_down * zd - py), cz = z + d * (zd - z);
+    const float ex = px + u * (rx[x] * zu - px), ey = py + u * (ry_up * zu - py), ez = z + u * (zu - z);
+    const float tux = ax - bx, tuy = ay - by, tuz = az - bz;
+    const float tvx = cx - ex, tvy = cy - ey, tvz = cz - ez;
+    // tv x tu faces the camera for any surface seen from the front (x right, y down, z forward).
+    const float n0 = tvy * tuz - tvz * tuy, n1 = tvz * tux - tvx * tuz, n2 = tvx * tuy - tvy * tux;
+    const float len2 = n0 * n0 + n1 * n1 + n2 * n2;
+    const float inv = ((z > 0) & (len2 > 0)) ? 1.f / std::sqrt(len2) : 0.f;
+    nx[x] = n0 * inv;
+    ny[x] = n1 * inv;
+    nz[x] = n2 * inv;
+  }
+}
+
+}  // namespace
+
 cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit) {
   const int rows = depth.rows, cols = depth.cols, s = step;
   // Zero padding: a neighbour outside the image is "no measurement", like a hole.
@@ -42,39 +76,10 @@ cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, in
 
   cv::Mat planes[3] = {cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F)};
   parallel_for_rows(rows, [&](int begin, int end) {
-    for (int y = begin; y < end; ++y) {
-      const float* up = padded.ptr<float>(y) + s;  // padded row y + s - s
-      const float* mid = padded.ptr<float>(y + s) + s;
-      const float* down = padded.ptr<float>(y + 2 * s) + s;
-      const float* rx = ray_x.data() + s;
-      const float ry = ray_y(y), ry_up = ray_y(y - s), ry_down = ray_y(y + s);
-      float* nx = planes[0].ptr<float>(y);
-      float* ny = planes[1].ptr<float>(y);
-      float* nz = planes[2].ptr<float>(y);
-      // Branch-free so that it vectorises: each tangent spans the neighbours that continue the
-      // surface (central difference), else one neighbour and the centre (one-sided), else nothing.
-      for (int x = 0; x < cols; ++x) {
-        const float z = mid[x], lim = jump_limit * z;
-        const float zl = mid[x - s], zr = mid[x + s], zu = up[x], zd = down[x];
-        const bool l = zl > 0 && std::abs(zl - z) <= lim, r = zr > 0 && std::abs(zr - z) <= lim;
-        const bool u = zu > 0 && std::abs(zu - z) <= lim, d = zd > 0 && std::abs(zd - z) <= lim;
-        const float px = rx[x] * z, py = ry * z;
-        // Horizontal tangent a - b, vertical tangent c - e.
-        const float ax = r ? rx[x + s] * zr : px, ay = r ? ry * zr : py, az = r ? zr : z;
-        const float bx = l ? rx[x - s] * zl : px, by = l ? ry * zl : py, bz = l ? zl : z;
-        const float cx = d ? rx[x] * zd : px, cy = d ? ry_down * zd : py, cz = d ? zd : z;
-        const float ex = u ? rx[x] * zu : px, ey = u ? ry_up * zu : py, ez = u ? zu : z;
-        const float tux = ax - bx, tuy = ay - by, tuz = az - bz;
-        const float tvx = cx - ex, tvy = cy - ey, tvz = cz - ez;
-        // tv x tu faces the camera for any surface seen from the front (x right, y down, z forward).
-        const float n0 = tvy * tuz - tvz * tuy, n1 = tvz * tux - tvx * tuz, n2 = tvx * tuy - tvy * tux;
-        const float len2 = n0 * n0 + n1 * n1 + n2 * n2;
-        const float inv = (z > 0 && len2 > 0) ? 1.f / std::sqrt(len2) : 0.f;
-        nx[x] = n0 * inv;
-        ny[x] = n1 * inv;
-        nz[x] = n2 * inv;
-      }
-    }
+    for (int y = begin; y < end; ++y)
+      raw_normal_row(padded.ptr<float>(y) + s, padded.ptr<float>(y + s) + s, padded.ptr<float>(y + 2 * s) + s,
+                     ray_x.data() + s, ray_y(y), ray_y(y - s), ray_y(y + s), cols, s, jump_limit,
+                     planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
   });
   if (ksize > 1)
     for (auto& p : planes) cv::GaussianBlur(p, p, cv::Size(ksize, ksize), 0, 0, cv::BORDER_REPLICATE);
@@ -86,7 +91,7 @@ cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, in
       float* nz = planes[2].ptr<float>(y);
       for (int x = 0; x < cols; ++x) {
         const float len2 = nx[x] * nx[x] + ny[x] * ny[x] + nz[x] * nz[x];
-        const float inv = (z[x] > 0 && len2 > 1e-12f) ? 1.f / std::sqrt(len2) : 0.f;
+        const float inv = ((z[x] > 0) & (len2 > 1e-12f)) ? 1.f / std::sqrt(len2) : 0.f;
         nx[x] *= inv;
         ny[x] *= inv;
         nz[x] *= inv;

@@ -80,7 +80,7 @@ cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& pa
         const float* v = frames[static_cast<size_t>(i)]->ptr<float>(y);
         for (int x = 0; x < depth.cols; ++x) {
           const float z = newest[x];
-          const bool take = v[x] > 0 && std::abs(v[x] - z) <= band_k * z * z;
+          const bool take = (v[x] > 0) & (std::abs(v[x] - z) <= band_k * z * z);
           sum[x] += take ? v[x] : 0.f;
           count[static_cast<size_t>(x)] += take ? 1.f : 0.f;
         }
