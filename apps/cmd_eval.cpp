@@ -2,6 +2,7 @@
 // dataset, per family, optionally over a parameter sweep; tables on stdout, CSV/JSON/HTML in --out.
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -160,8 +161,13 @@ struct Evaluation {
   int gallery_frames = 0;
 };
 
+// Makes a fresh method: one per scene, so no temporal state leaks from one scene into the next.
+using MethodFactory = std::function<Method()>;
+
 // Runs one method over every frame in order; a frame that fails is recorded and the run goes on.
-void run_over_frames(const Evaluation& ev, Method& method, RunRecord& run, EvalReport& report) {
+void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord& run, EvalReport& report) {
+  Method method = make();
+  std::string scene = ev.source.size() > 0 ? ev.infos.at(ev.source.name(0)).scene : "";
   const bool fill_gallery = report.gallery.empty();
   std::vector<std::pair<std::string, std::pair<double, int>>> stage_sums;
   Progress progress("eval " + run.label, ev.source.size());
@@ -171,6 +177,10 @@ void run_over_frames(const Evaluation& ev, Method& method, RunRecord& run, EvalR
     rec.frame = name;
     rec.family = ev.infos.at(name).family;
     rec.scene = ev.infos.at(name).scene;
+    if (rec.scene != scene) {
+      method = make();
+      scene = rec.scene;
+    }
     try {
       const Frame frame = ev.source.load(i);
       if (frame.label.empty())
@@ -190,16 +200,18 @@ void run_over_frames(const Evaluation& ev, Method& method, RunRecord& run, EvalR
         ++it->second.second;
         if (stage == "total") rec.total_ms = ms;
       }
-      if (static_cast<int>(i) < ev.gallery_frames) try {
-        const cv::Mat depth_m = depth_in_metres(frame);
-        run.predictions.emplace_back(name, thumbnail(render_overlay(out.labels, frame.color, depth_m)));
-        if (fill_gallery) {
-          const cv::Mat image = frame.color.empty() ? render_depth(depth_m) : frame.color;
-          report.gallery.push_back(
-              {name, rec.family, thumbnail(image), thumbnail(render_overlay(frame.label, frame.color, depth_m))});
+      if (static_cast<int>(i) < ev.gallery_frames) {
+        try {
+          const cv::Mat depth_m = depth_in_metres(frame);
+          run.predictions.emplace_back(name, thumbnail(render_overlay(out.labels, frame.color, depth_m)));
+          if (fill_gallery) {
+            const cv::Mat image = frame.color.empty() ? render_depth(depth_m) : frame.color;
+            report.gallery.push_back(
+                {name, rec.family, thumbnail(image), thumbnail(render_overlay(frame.label, frame.color, depth_m))});
+          }
+        } catch (const std::exception& e) {  // a picture that cannot be drawn does not cost the scores
+          report_error(run.label + ": " + name + ": no picture for the report: " + e.what());
         }
-      } catch (const std::exception& e) {  // a picture that cannot be drawn does not cost the scores
-        report_error(run.label + ": " + name + ": no picture for the report: " + e.what());
       }
     } catch (const std::exception& e) {  // Error, or an OpenCV/PCL exception inside a method
       rec.error = e.what();
@@ -236,13 +248,18 @@ int run(const EvalOptions& o) {
   if (!o.sweep.empty()) sweep = parse_sweep(o.sweep);
 
   // Every method is made before the first frame, so a bad name or parameter fails at once.
-  std::vector<std::pair<RunRecord, Method>> runs;
+  std::vector<std::pair<RunRecord, MethodFactory>> runs;
+  const auto factory = [](const std::string& name, const Params& params) {
+    make_method(name, params);  // an unknown name fails here, before the first frame
+    return MethodFactory([name, params] { return make_method(name, params); });
+  };
   if (!o.pred.empty()) {
     RunRecord r;
     r.method = "pred";
     r.label = fs::path(o.pred).filename().string();  // the folder's name says which tool made it
     if (r.label.empty() || r.label == ".") r.label = "pred";
-    runs.emplace_back(r, prediction_folder(o.pred));
+    const Method pred = prediction_folder(o.pred);
+    runs.emplace_back(r, [pred] { return pred; });
   } else if (sweep) {
     for (double v : sweep->values) {
       RunRecord r;
@@ -251,18 +268,18 @@ int run(const EvalOptions& o) {
       std::ostringstream label;
       label << "clutterseg " << sweep->name << "=" << v;
       r.label = label.str();
-      runs.emplace_back(r, make_method("clutterseg", with_value(base, *sweep, v)));
+      runs.emplace_back(r, factory("clutterseg", with_value(base, *sweep, v)));
     }
   } else {
     RunRecord r;
     r.method = r.label = "clutterseg";
-    runs.emplace_back(r, make_method("clutterseg", base));
+    runs.emplace_back(r, factory("clutterseg", base));
   }
   for (const auto& name : o.with) {
     if (name == "clutterseg") continue;
     RunRecord r;
     r.method = r.label = name;
-    runs.emplace_back(r, make_method(name, base));
+    runs.emplace_back(r, factory(name, base));
   }
 
   EvalReport report;
@@ -276,8 +293,8 @@ int run(const EvalOptions& o) {
   if (sweep) report.sweep_parameter = sweep->name;
 
   const Evaluation ev{source, infos, o.dataset, o.out.empty() ? 0 : std::max(0, o.report_frames)};
-  for (auto& [record, method] : runs) {
-    run_over_frames(ev, method, record, report);
+  for (auto& [record, make] : runs) {
+    run_over_frames(ev, make, record, report);
     record.groups = summarize(record.frames);
     report.runs.push_back(std::move(record));
   }

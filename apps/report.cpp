@@ -270,9 +270,12 @@ std::string draw_plots(const fs::path& out) {
   const fs::path script = out / ".report_plots.py", log = out / ".report_plots.log";
   write_text_atomic(script, kReportPlotsPy);
   std::vector<std::string> candidates;
-  if (const char* env = std::getenv("CLUTTERSEG_PYTHON"); env && *env) candidates.push_back(env);
-  for (const char* p : {"/usr/bin/python3", "python3"})
-    if (std::find(candidates.begin(), candidates.end(), p) == candidates.end()) candidates.push_back(p);
+  // CLUTTERSEG_PYTHON picks the interpreter; else Debian's python3 (which has python3-matplotlib)
+  // before whatever python3 comes first on PATH.
+  if (const char* env = std::getenv("CLUTTERSEG_PYTHON"); env && *env)
+    candidates.push_back(env);
+  else
+    candidates = {"/usr/bin/python3", "python3"};
   std::string failure;
   for (const auto& python : candidates) {
     const int code = run_program(python, {script.string(), out.string()}, log);
@@ -326,14 +329,14 @@ caption { text-align: left; font-weight: bold; padding: 4px 0; }
 tr.best td { background: #e6f4e6; font-weight: bold; }
 .meta, .note { color: #555; font-size: 0.9em; }
 .plots { display: flex; flex-wrap: wrap; gap: 12px; } .plots figure { margin: 0; }
-.plots img { max-width: 610px; border: 1px solid #ddd; }
+.plots img { width: 590px; border: 1px solid #ddd; }
 .frame .row { display: flex; flex-wrap: wrap; gap: 6px; } .frame figure { margin: 0; }
 .frame img { width: 300px; display: block; } figcaption { font-size: 0.8em; color: #444; }
 </style></head><body>
 <h1>clutterseg eval</h1>
 )";
   h << "<p class=\"meta\">Dataset <code>" << html_escape(report.dataset) << "</code>: " << report.frames
-    << " frames, " << report.scenes << " scenes. Scores in %: per scene the mean over its frames, then the mean "
+    << " frame(s), " << report.scenes << " scene(s). Scores in %: per scene the mean over its frames, then the mean "
     << "(± population standard deviation for the paper's scores) over scenes. Boundary tolerance "
     << report.boundary_tolerance_px << " px.<br>Command: <code>" << html_escape(report.command) << "</code></p>\n";
 
@@ -422,6 +425,10 @@ tr.best td { background: #e6f4e6; font-weight: bold; }
   if (!report.params_json.empty())
     h << "<h2>Parameters</h2>\n<details><summary>clutterseg parameters (JSON)</summary><pre>"
       << html_escape(report.params_json) << "</pre></details>\n";
+  // Lets a headless browser test see that every embedded picture decoded (data-images-decoded="n/n").
+  h << "<script>window.addEventListener('load', () => { const all = Array.from(document.images); "
+       "document.body.setAttribute('data-images-decoded', all.filter(i => i.naturalWidth > 0).length + '/' + "
+       "all.length); });</script>\n";
   h << "</body></html>\n";
   return h.str();
 }

@@ -76,7 +76,7 @@ def timings(summary, path):
         for name, _ in run["timings_ms"]:
             if name != "total" and name not in stages:
                 stages.append(name)
-    fig, ax = plt.subplots(figsize=(7.2, 0.9 + 0.55 * len(runs) + 0.12 * len(stages)))
+    fig, ax = plt.subplots(figsize=(6.4, max(1.2 + 0.45 * len(runs), 0.3 + 0.2 * len(stages))))
     ys = range(len(runs))
     left = [0.0] * len(runs)
     cmap = plt.get_cmap("tab20")
@@ -92,7 +92,7 @@ def timings(summary, path):
     ax.set_xlabel("mean time per frame [ms]")
     ax.set_xlim(0, max(left) * 1.25 if max(left) > 0 else 1)
     ax.set_title("Time per stage (mean over frames)")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.25), ncol=4, fontsize=7, frameon=False)
+    ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=7, frameon=False)
     fig.tight_layout()
     fig.savefig(path, bbox_inches="tight")
     plt.close(fig)
@@ -124,9 +124,9 @@ def families(summary, path):
     ax.set_ylim(0, 105)
     ax.set_ylabel("[%]")
     ax.set_title("Per family: paper tp and UOIS Overlap F")
-    ax.legend(fontsize=7, loc="lower right")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.tight_layout()
-    fig.savefig(path)
+    fig.savefig(path, bbox_inches="tight")
     plt.close(fig)
 
 
@@ -154,9 +154,9 @@ def sweep(summary, path):
     ax.set_ylabel("[%]")
     ax.set_ylim(0, 105)
     ax.set_title(f"Sweep of {param} (all frames)")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.tight_layout()
-    fig.savefig(path)
+    fig.savefig(path, bbox_inches="tight")
     plt.close(fig)
     return True
 

@@ -29,9 +29,9 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-CliRun run_cli(const std::string& args, const fs::path& tmp) {
+CliRun run_cli(const std::string& args, const fs::path& tmp, const std::string& env = "") {
   const fs::path out = tmp / "stdout.txt", err = tmp / "stderr.txt";
-  const std::string cmd = std::string(CLUTTERSEG_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+  const std::string cmd = env + std::string(CLUTTERSEG_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(cmd.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
 }
@@ -118,6 +118,23 @@ TEST(EvalCli, ScoresPredictionsPerFamilyAndReportsTheFailingFrame) {
   EXPECT_NE(html.find("<table class=\"summary\""), std::string::npos);
   EXPECT_NE(html.find("id=\"frame-a\""), std::string::npos);
   EXPECT_NE(html.find("Failed frames"), std::string::npos);
+  fs::remove_all(tmp);
+}
+
+TEST(EvalCli, WithoutMatplotlibTheReportSaysSoInOneLineAndHasEverythingElse) {
+  const fs::path tmp = fresh_dir("noplots");
+  const fs::path ds = tiny_dataset(tmp / "ds");
+  fs::copy(ds / "pred" / "a.png", ds / "pred" / "c.png");
+  const CliRun r = run_cli("eval " + ds.string() + " --pred " + (ds / "pred").string() + " --out " +
+                               (tmp / "o").string(),
+                           tmp, "CLUTTERSEG_PYTHON=/nonexistent/python3 ");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("Plots are missing: no python3 with matplotlib"), std::string::npos) << r.err;
+  const std::string html = slurp(tmp / "o" / "report.html");
+  EXPECT_NE(html.find("<p class=\"note\" id=\"plot-note\">Plots are missing"), std::string::npos);
+  EXPECT_EQ(html.find("id=\"plot-scatter\""), std::string::npos);
+  EXPECT_NE(html.find("<table class=\"summary\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"frame-c\""), std::string::npos);
   fs::remove_all(tmp);
 }
 
