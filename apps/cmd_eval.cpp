@@ -111,7 +111,8 @@ std::map<std::string, FrameInfo> frame_infos(const fs::path& dataset, const Fram
       throw Error(file.string() + ": every frame needs a \"name\"");
     const auto it = infos.find(f["name"].get<std::string>());
     if (it == infos.end()) continue;  // a frame the dataset does not hold
-    if (f.contains("family") && f["family"].is_string()) it->second.family = f["family"].get<std::string>();
+    // A listed frame without a family is only in "all" (scenes.json may name scenes only).
+    it->second.family = f.contains("family") && f["family"].is_string() ? f["family"].get<std::string>() : "all";
     if (f.contains("scene") && (f["scene"].is_string() || f["scene"].is_number()))
       it->second.scene = f["scene"].is_string() ? f["scene"].get<std::string>() : f["scene"].dump();
   }
@@ -193,6 +194,7 @@ void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord&
         throw Error(frame.path.string() + ": " + e.what());
       }
       rec.scores = score_frame(frame.label, out.labels);
+      report.boundary_tolerance_px = boundary_tolerance_px(frame.label.size());  // one camera per set
       for (const auto& [stage, ms] : out.timings_ms) {
         auto it = std::find_if(stage_sums.begin(), stage_sums.end(), [&](const auto& s) { return s.first == stage; });
         if (it == stage_sums.end()) it = stage_sums.insert(stage_sums.end(), {stage, {0.0, 0}});
@@ -297,11 +299,6 @@ int run(const EvalOptions& o) {
     run_over_frames(ev, make, record, report);
     record.groups = summarize(record.frames);
     report.runs.push_back(std::move(record));
-  }
-  // Tolerance from the first frame's size (all frames of a set share the camera).
-  if (source.size() > 0) {
-    const Frame first = source.load(0);
-    report.boundary_tolerance_px = boundary_tolerance_px(first.depth.size());
   }
 
   // The sweep's best value by Overlap F over all frames; it is the clutterseg run shown in the plots.
