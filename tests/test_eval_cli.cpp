@@ -162,6 +162,20 @@ TEST(EvalCli, SequenceCountsOneSceneAndSegmentOutputFolderIsAccepted) {
   fs::remove_all(tmp);
 }
 
+TEST(EvalCli, ScenesJsonNamesScenesSoASequenceCountsOnce) {
+  const fs::path tmp = fresh_dir("scenes");
+  const fs::path ds = tiny_dataset(tmp / "ds");
+  fs::copy(ds / "pred" / "b.png", ds / "pred" / "c.png");
+  std::ofstream(ds / "scenes.json") << R"({"frames": [{"name": "a", "scene": "desk"}, {"name": "b", "scene": "desk"},
+      {"name": "c", "scene": "shelf"}]})";
+  const CliRun r = run_cli("eval " + ds.string() + " --pred " + (ds / "pred").string(), tmp);
+  EXPECT_EQ(r.code, 0) << r.err;
+  // desk = mean of a (1) and b (0.5) = 0.75, shelf = c (0.5): mean 0.625, std 0.125 over 2 scenes.
+  EXPECT_NE(r.out.find("| all | 3 | 2 | 62.5 ± 12.5 |"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("| unlisted |"), std::string::npos) << "frames without a family are in all only";
+  fs::remove_all(tmp);
+}
+
 TEST(EvalCli, SweepPrintsATablePerValueAndMarksTheBest) {
   const fs::path tmp = fresh_dir("sweep");
   scenes::TestScene s = scenes::box_on_plane();
@@ -201,6 +215,10 @@ TEST(EvalCli, BadInputsAreOneLineErrors) {
   EXPECT_NE(r.err.find("--sweep theta_c=0.9:0.3:0.1: needs STEP > 0 and STOP >= START"), std::string::npos) << r.err;
   r = run_cli("eval " + ds.string() + " --sweep nosuch=1:2:1", tmp);
   EXPECT_NE(r.err.find("--sweep: unknown parameter 'nosuch'"), std::string::npos) << r.err;
+  r = run_cli("eval " + ds.string() + " --sweep patches.min_size_px=10.5:20:5", tmp);
+  EXPECT_NE(r.err.find("--sweep: 'patches.min_size_px' takes whole numbers"), std::string::npos) << r.err;
+  r = run_cli("eval " + ds.string() + " --sweep seed=1:2", tmp);
+  EXPECT_NE(r.err.find("the range is not START:STOP:STEP"), std::string::npos) << r.err;
   r = run_cli("eval " + ds.string() + " --with nosuch", tmp);
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.err.find("unknown method 'nosuch'"), std::string::npos) << r.err;
