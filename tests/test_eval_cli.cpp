@@ -10,38 +10,14 @@
 #include <sstream>
 
 #include "clutterseg/io.hpp"
+#include "cli.hpp"
 #include "scenes.hpp"
 
 using namespace clutterseg;
+using namespace clutterseg::testing_cli;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-CliRun run_cli(const std::string& args, const fs::path& tmp, const std::string& env = "") {
-  const fs::path out = tmp / "stdout.txt", err = tmp / "stderr.txt";
-  const std::string cmd = env + std::string(CLUTTERSEG_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("clutterseg-eval-" + name + "-" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 void write_labels(const fs::path& p, const cv::Mat& labels) {
   fs::create_directories(p.parent_path());
