@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 
 #include "clutterseg/occlusion.hpp"
@@ -15,7 +16,10 @@ namespace {
 // the sign decides convexity. An ideal cylinder or sphere gives exactly +-1; noise and a flat part
 // pull it towards 0.
 constexpr double kConvexityCorrelation = 0.5;
-constexpr int kMinPeakPoints = 3;  // fewest peak-bin points per patch for a line fit
+constexpr int kMinPeakPoints = 3;            // fewest peak-bin points per patch for a line fit
+// Large patches are subsampled on a fixed pixel stride (deterministic) for the statistics below.
+constexpr size_t kConvexitySamples = 1024;  // pixels used at most for the moments of a patch
+constexpr size_t kBinnedSamples = 2048;     // pixels used at most for a patch's peak-bin points
 
 Eigen::Vector3f vec(const cv::Vec3f& v) { return {v[0], v[1], v[2]}; }
 
@@ -29,56 +33,87 @@ int histogram_side(const std::vector<float>& histogram) {
   return static_cast<int>(std::lround(std::sqrt(static_cast<double>(histogram.size()))));
 }
 
-// Image bounding box of each patch in the label image (edge pixels included once assigned).
-std::vector<cv::Rect> label_boxes(const cv::Mat& labels, int num_patches) {
-  std::vector<cv::Rect> boxes(static_cast<size_t>(num_patches));
-  std::vector<int> x0(boxes.size(), labels.cols), y0(boxes.size(), labels.rows), x1(boxes.size(), -1), y1(boxes.size(), -1);
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* row = labels.ptr<int>(y);
-    for (int x = 0; x < labels.cols; ++x) {
-      const int id = row[x];
-      if (id <= 0 || id > num_patches) continue;
-      const auto k = static_cast<size_t>(id - 1);
-      x0[k] = std::min(x0[k], x); x1[k] = std::max(x1[k], x);
-      y0[k] = std::min(y0[k], y); y1[k] = std::max(y1[k], y);
-    }
-  }
-  for (size_t k = 0; k < boxes.size(); ++k)
-    if (x1[k] >= 0) boxes[k] = cv::Rect(x0[k], y0[k], x1[k] - x0[k] + 1, y1[k] - y0[k] + 1);
-  return boxes;
-}
-
 cv::Rect grown(const cv::Rect& r, int by) { return {r.x - by, r.y - by, r.width + 2 * by, r.height + 2 * by}; }
 
-// Some pixel of patch a lies within `gap` pixels of some pixel of patch b. Both such pixels lie in
-// the overlap of the two grown boxes, so a distance transform over that overlap decides it exactly.
-bool image_neighbours(const cv::Mat& labels, int id_a, const cv::Rect& box_a, int id_b, const cv::Rect& box_b, int gap) {
-  if (box_a.empty() || box_b.empty()) return false;
-  const cv::Rect roi = grown(box_a, gap) & grown(box_b, gap) & cv::Rect(0, 0, labels.cols, labels.rows);
-  if (roi.empty()) return false;
-  const cv::Mat window = labels(roi);
-  const cv::Mat not_a = window != id_a;
-  if (cv::countNonZero(not_a) == static_cast<int>(window.total())) return false;
-  cv::Mat distance;
-  cv::distanceTransform(not_a, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  for (int y = 0; y < roi.height; ++y) {
-    const int* l = window.ptr<int>(y);
-    const float* d = distance.ptr<float>(y);
-    for (int x = 0; x < roi.width; ++x)
-      if (l[x] == id_b && d[x] <= static_cast<float>(gap)) return true;
+// Per label (index id - 1, only where `wanted`), the pixels with an 8-neighbour outside the label:
+// one pass over the image. The two closest pixels of two disjoint patches are boundary pixels: from
+// an interior pixel, a step towards the other patch stays inside and gets closer.
+std::vector<std::vector<cv::Point>> boundaries(const cv::Mat& labels, const std::vector<char>& wanted) {
+  std::vector<std::vector<cv::Point>> out(wanted.size());
+  const int max_id = static_cast<int>(wanted.size());
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* row = labels.ptr<int>(y);
+    const int* up = y > 0 ? labels.ptr<int>(y - 1) : nullptr;
+    const int* down = y + 1 < labels.rows ? labels.ptr<int>(y + 1) : nullptr;
+    for (int x = 0; x < labels.cols; ++x) {
+      const int id = row[x];
+      if (id <= 0 || id > max_id || !wanted[static_cast<size_t>(id - 1)]) continue;
+      bool edge = !up || !down || x == 0 || x + 1 == labels.cols;
+      for (int dx = -1; dx <= 1 && !edge; ++dx) edge = up[x + dx] != id || down[x + dx] != id || row[x + dx] != id;
+      if (edge) out[static_cast<size_t>(id - 1)].emplace_back(x, y);
+    }
+  }
+  return out;
+}
+
+// Some pixel of a lies within `gap` pixels of some pixel of b (boundaries of both), via a grid of
+// gap-sized cells over b's boundary: O(|boundary a| + |boundary b|).
+bool within_gap(const std::vector<cv::Point>& a, const std::vector<cv::Point>& b, int gap, cv::Size image) {
+  if (a.empty() || b.empty()) return false;
+  const int cols = image.width / gap + 1, rows = image.height / gap + 1;
+  std::vector<int> start(static_cast<size_t>(cols * rows) + 1, 0);
+  auto cell = [&](const cv::Point& p) { return (p.y / gap) * cols + p.x / gap; };
+  for (const auto& p : b) ++start[static_cast<size_t>(cell(p)) + 1];
+  for (size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<cv::Point> sorted(b.size());
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (const auto& p : b) sorted[static_cast<size_t>(fill[static_cast<size_t>(cell(p))]++)] = p;
+  const int gap2 = gap * gap;
+  for (const auto& p : a) {
+    const int cx = p.x / gap, cy = p.y / gap;
+    for (int y = std::max(0, cy - 1); y <= std::min(rows - 1, cy + 1); ++y)
+      for (int x = std::max(0, cx - 1); x <= std::min(cols - 1, cx + 1); ++x)
+        for (int k = start[static_cast<size_t>(y * cols + x)]; k < start[static_cast<size_t>(y * cols + x) + 1]; ++k) {
+          const cv::Point d = sorted[static_cast<size_t>(k)] - p;
+          if (d.x * d.x + d.y * d.y <= gap2) return true;
+        }
   }
   return false;
 }
 
-// Points of a patch whose normal falls into histogram bin `bin`.
-std::vector<Eigen::Vector3f> bin_points(const Patch& patch, int bin, int bins, const cv::Mat& points, const cv::Mat& normals) {
-  std::vector<Eigen::Vector3f> out;
-  const auto* pts = points.ptr<cv::Vec3f>();
-  const auto* nrm = normals.ptr<cv::Vec3f>();
-  for (int i : patch.pixels)
-    if (pts[i][2] > 0 && histogram_bin(nrm[i], bins) == bin) out.push_back(vec(pts[i]));
-  return out;
-}
+// A patch's pixels (at most kBinnedSamples of them, on a fixed stride) grouped by the histogram bin
+// of their normal (counting sort), built once per patch so each pair only reads the bin it needs.
+struct BinnedPixels {
+  std::vector<int> start;   // bins*bins + 1 offsets into `pixels`
+  std::vector<int> pixels;  // valid pixels, ordered by bin
+
+  BinnedPixels(const Patch& patch, int bins, const cv::Mat& points, const cv::Mat& normals) {
+    const auto* pts = points.ptr<cv::Vec3f>();
+    const auto* nrm = normals.ptr<cv::Vec3f>();
+    const size_t stride = std::max<size_t>(1, patch.pixels.size() / kBinnedSamples);
+    std::vector<int> sampled, bin_of;
+    start.assign(static_cast<size_t>(bins * bins) + 1, 0);
+    for (size_t k = 0; k < patch.pixels.size(); k += stride) {
+      const int i = patch.pixels[k];
+      if (!(pts[i][2] > 0)) continue;
+      sampled.push_back(i);
+      bin_of.push_back(histogram_bin(nrm[i], bins));
+      ++start[static_cast<size_t>(bin_of.back()) + 1];
+    }
+    for (size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    pixels.resize(sampled.size());
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (size_t k = 0; k < sampled.size(); ++k) pixels[static_cast<size_t>(fill[static_cast<size_t>(bin_of[k])]++)] = sampled[k];
+  }
+
+  std::vector<Eigen::Vector3f> points_in(int bin, const cv::Mat& points) const {
+    const auto* pts = points.ptr<cv::Vec3f>();
+    std::vector<Eigen::Vector3f> out;
+    for (int k = start[static_cast<size_t>(bin)]; k < start[static_cast<size_t>(bin) + 1]; ++k)
+      out.push_back(vec(pts[pixels[static_cast<size_t>(k)]]));
+    return out;
+  }
+};
 
 struct Line {
   Eigen::Vector3f point, direction;
@@ -110,16 +145,15 @@ float rms_distance(const Line& line, const std::vector<Eigen::Vector3f>& set) {
 // Paper h), occluded curved object: the points of the bin both histograms share most (for a
 // cylinder: a generator line on each part) lie on one 3D line, and the stretch of that line between
 // the two parts is hidden by something in front, not open to the background.
-bool aligned_and_occluded(const Patch& a, const Patch& b, const cv::Mat& points, const cv::Mat& normals,
-                          const Camera& camera, const Params& params) {
-  const int bins = histogram_side(a.histogram);
+bool aligned_and_occluded(const Patch& a, const BinnedPixels& binned_a, const Patch& b, const BinnedPixels& binned_b,
+                          const cv::Mat& points, const Camera& camera, const Params& params) {
   int peak = 0;
   float best = -1;
   for (size_t k = 0; k < a.histogram.size(); ++k) {
     const float shared = std::min(a.histogram[k], b.histogram[k]);
     if (shared > best) { best = shared; peak = static_cast<int>(k); }
   }
-  const auto pa = bin_points(a, peak, bins, points, normals), pb = bin_points(b, peak, bins, points, normals);
+  const auto pa = binned_a.points_in(peak, points), pb = binned_b.points_in(peak, points);
   if (static_cast<int>(pa.size()) < kMinPeakPoints || static_cast<int>(pb.size()) < kMinPeakPoints) return false;
   const Line line = fit_line(pa, pb);
   // Each part must follow the line, so a large part cannot hide a small one that is off the line.
@@ -152,37 +186,35 @@ int convexity(const Patch& patch, const cv::Mat& points, const cv::Mat& normals,
   // dn = S dp with a positive shape operator S; on a concave one it turns against. We find the
   // direction e in which the normals vary most (the major axis of the histogram blob, paper Eq. 4)
   // and correlate n.e with p.e over the patch: the sign is the sign of the curvature along e.
+  // One pass of first and second moments; large patches are subsampled on a fixed stride.
   const auto* pts = points.ptr<cv::Vec3f>();
   const auto* nrm = normals.ptr<cv::Vec3f>();
-  std::vector<int> valid;
-  valid.reserve(patch.pixels.size());
-  for (int i : patch.pixels)
-    if (pts[i][2] > 0 && (nrm[i][0] != 0 || nrm[i][1] != 0 || nrm[i][2] != 0)) valid.push_back(i);
-  if (valid.size() < 10) return 0;
-
-  Eigen::Vector3d n_mean = Eigen::Vector3d::Zero(), p_mean = Eigen::Vector3d::Zero();
-  for (int i : valid) { n_mean += vec(nrm[i]).cast<double>(); p_mean += vec(pts[i]).cast<double>(); }
-  n_mean /= static_cast<double>(valid.size());
-  p_mean /= static_cast<double>(valid.size());
-  Eigen::Matrix3d n_cov = Eigen::Matrix3d::Zero();
-  for (int i : valid) {
-    const Eigen::Vector3d d = vec(nrm[i]).cast<double>() - n_mean;
-    n_cov += d * d.transpose();
+  const size_t stride = std::max<size_t>(1, patch.pixels.size() / kConvexitySamples);
+  Eigen::Vector3d sn = Eigen::Vector3d::Zero(), sp = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d snn = Eigen::Matrix3d::Zero(), snp = Eigen::Matrix3d::Zero(), spp = Eigen::Matrix3d::Zero();
+  double count = 0;
+  for (size_t k = 0; k < patch.pixels.size(); k += stride) {
+    const int i = patch.pixels[k];
+    if (!(pts[i][2] > 0) || (nrm[i][0] == 0 && nrm[i][1] == 0 && nrm[i][2] == 0)) continue;
+    const Eigen::Vector3d n = vec(nrm[i]).cast<double>(), p = vec(pts[i]).cast<double>();
+    sn += n; sp += p;
+    snn.noalias() += n * n.transpose();
+    snp.noalias() += n * p.transpose();
+    spp.noalias() += p * p.transpose();
+    ++count;
   }
-  n_cov /= static_cast<double>(valid.size());
+  if (count < 10) return 0;
+  const Eigen::Vector3d n_mean = sn / count, p_mean = sp / count;
+  const Eigen::Matrix3d n_cov = snn / count - n_mean * n_mean.transpose();
+  const Eigen::Matrix3d np_cov = snp / count - n_mean * p_mean.transpose();
+  const Eigen::Matrix3d p_cov = spp / count - p_mean * p_mean.transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(n_cov);
   const Eigen::Vector3d e = eig.eigenvectors().col(2);
   // Normals that vary by less than a histogram bin along e: no curvature to judge.
   if (2 * std::sqrt(std::max(0.0, eig.eigenvalues()(2))) < 2.0 / std::max(1, bins)) return 0;
-
-  double snp = 0, snn = 0, spp = 0;
-  for (int i : valid) {
-    const double dn = (vec(nrm[i]).cast<double>() - n_mean).dot(e);
-    const double dp = (vec(pts[i]).cast<double>() - p_mean).dot(e);
-    snp += dn * dp; snn += dn * dn; spp += dp * dp;
-  }
-  if (snn <= 0 || spp <= 0) return 0;
-  const double correlation = snp / std::sqrt(snn * spp);
+  const double var_n = e.dot(n_cov * e), var_p = e.dot(p_cov * e), cov_np = e.dot(np_cov * e);
+  if (var_n <= 0 || var_p <= 0) return 0;
+  const double correlation = cov_np / std::sqrt(var_n * var_p);
   return correlation > kConvexityCorrelation ? 1 : correlation < -kConvexityCorrelation ? -1 : 0;
 }
 
@@ -215,25 +247,59 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   if (similar.empty()) return out;
 
   const int gap = std::max(1, static_cast<int>(std::lround(p.neighbour_gap_px * resolution_scale(assigned_labels.cols))));
-  int max_id = 0;
-  for (const auto& patch : patches) max_id = std::max(max_id, patch.id);
-  const auto boxes = label_boxes(assigned_labels, max_id);
-  auto box_of = [&](const Patch& patch) { return patch.id > 0 ? boxes[static_cast<size_t>(patch.id - 1)] : cv::Rect(); };
+  // Edge pixels join a patch only within the adjacency radius of its core pixels (paper d), so the
+  // core box grown by that radius holds all of the patch's assigned pixels.
+  const int assign_radius = static_cast<int>(std::ceil(params.adjacency.radius_px * resolution_scale(assigned_labels.cols)));
+  auto box_of = [&](const Patch& patch) { return grown(patch.bbox, assign_radius); };
   std::vector<int> convex(patches.size(), 2);  // 2 = not computed yet
   auto convexity_of = [&](int i) {
     auto& c = convex[static_cast<size_t>(i)];
     if (c == 2) c = convexity(patches[static_cast<size_t>(i)], points, normals, histogram_side(patches[static_cast<size_t>(i)].histogram));
     return c;
   };
+  // Boundaries of all similar patches in one pass over the image, the first time a pair needs them.
+  std::vector<std::vector<cv::Point>> boundary_by_id;
+  auto boundary_of = [&](int i) -> const std::vector<cv::Point>& {
+    if (boundary_by_id.empty()) {
+      std::vector<char> wanted;
+      for (const auto& [x, y] : similar)
+        for (const int k : {x, y}) {
+          const int id = patches[static_cast<size_t>(k)].id;
+          if (id > static_cast<int>(wanted.size())) wanted.resize(static_cast<size_t>(id), 0);
+          if (id > 0) wanted[static_cast<size_t>(id - 1)] = 1;
+        }
+      boundary_by_id = boundaries(assigned_labels, wanted);
+    }
+    return boundary_by_id[static_cast<size_t>(patches[static_cast<size_t>(i)].id - 1)];
+  };
+  auto neighbours = [&](int i, int j) {
+    const auto& a = patches[static_cast<size_t>(i)];
+    const auto& b = patches[static_cast<size_t>(j)];
+    if (a.id <= 0 || b.id <= 0 || (grown(box_of(a), gap) & box_of(b)).area() == 0) return false;
+    return within_gap(boundary_of(i), boundary_of(j), gap, assigned_labels.size());
+  };
+  std::vector<std::unique_ptr<BinnedPixels>> binned(patches.size());
+  auto binned_of = [&](int i) -> const BinnedPixels& {
+    auto& b = binned[static_cast<size_t>(i)];
+    const Patch& patch = patches[static_cast<size_t>(i)];
+    if (!b) b = std::make_unique<BinnedPixels>(patch, histogram_side(patch.histogram), points, normals);
+    return *b;
+  };
+  // Cheapest test first per rule; the image-neighbour test (which decides between the two rules)
+  // only for pairs that one rule would link.
   for (const auto& [i, j] : similar) {
     const auto& a = patches[static_cast<size_t>(i)];
     const auto& b = patches[static_cast<size_t>(j)];
-    if (image_neighbours(assigned_labels, a.id, box_of(a), b.id, box_of(b), gap)) {
-      // Open object: the outer (convex) and inner (concave) wall of a cup or bowl meet at the rim.
-      if (p.open_objects && convexity_of(i) * convexity_of(j) == -1) out.push_back({{i, j}, Cue::CurvatureOpen});
-    } else if (p.occluded && aligned_and_occluded(a, b, points, normals, camera, params)) {
-      out.push_back({{i, j}, Cue::CurvatureOccluded});
+    // Open object: the outer (convex) and inner (concave) wall of a cup or bowl meet at the rim.
+    if (p.open_objects && convexity_of(i) * convexity_of(j) == -1) {
+      if (neighbours(i, j)) {
+        out.push_back({{i, j}, Cue::CurvatureOpen});
+        continue;
+      }
     }
+    // Occluded curved object: aligned, with an occluder between, and not image neighbours.
+    if (p.occluded && aligned_and_occluded(a, binned_of(i), b, binned_of(j), points, camera, params) && !neighbours(i, j))
+      out.push_back({{i, j}, Cue::CurvatureOccluded});
   }
   return out;
 }
