@@ -117,6 +117,7 @@ std::vector<PatchPair> coplanar_pairs(const std::vector<Patch>& patches, const s
                                       const Params::Coplanarity& params, std::uint64_t seed) {
   std::vector<PatchPair> out;
   if (!params.enabled) return out;
+  if (points.type() != CV_32FC3) throw Error("coplanar_pairs: points must be a CV_32FC3 image");
   std::vector<PatchPair> known = linked;
   for (auto& pair : known)
     if (pair.first > pair.second) std::swap(pair.first, pair.second);

@@ -223,6 +223,9 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   std::vector<CurvatureLink> out;
   const auto& p = params.curvature;
   if (!p.enabled || (!p.open_objects && !p.occluded)) return out;
+  if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || normals.type() != CV_32FC3 ||
+      assigned_labels.size() != points.size() || normals.size() != points.size())
+    throw Error("curvature_links: labels (CV_32S), points and normals (CV_32FC3) must be images of one size");
   std::vector<PatchPair> known = linked;
   for (auto& pair : known)
     if (pair.first > pair.second) std::swap(pair.first, pair.second);
