@@ -130,3 +130,23 @@ TEST(Coplanarity, DeterministicForAnySeedAndThreadCount) {
   set_threads(0);
   for (std::uint64_t seed : {1, 2, 3, 99}) EXPECT_EQ(coplanar_pairs(r.patches, {}, r.points, camera, {}, seed).size(), 2u);
 }
+
+TEST(Coplanarity, SameDecisionsAtVga) {
+  // Every threshold is physical or scaled with the resolution: 640x480 decides as 320x240 does.
+  for (auto make : {occluded_box_split, separate_boxes}) {
+    TestScene scene = make();
+    scene.camera = synth::default_camera(640, 480);
+    const Segmented s = segment_scene(scene);
+    const auto pairs = coplanar_pairs(s.result.patches, {}, s.result.points, scene.camera, {}, 1);
+    if (make == occluded_box_split) {
+      ASSERT_EQ(pairs.size(), 2u);
+      const auto on_box = patches_on(s, 1);
+      for (const auto& [a, b] : pairs) {  // each joins two parts of one face of the occluded box
+        EXPECT_EQ(std::count(on_box.begin(), on_box.end(), a) + std::count(on_box.begin(), on_box.end(), b), 2);
+        EXPECT_GT(patch(s, a).mean_normal.dot(patch(s, b).mean_normal), 0.99f);
+      }
+    } else {
+      EXPECT_TRUE(pairs.empty());
+    }
+  }
+}

@@ -135,3 +135,24 @@ TEST(Curvature, AlignedCylindersWithTableBetweenAreNotLinked) {
   strict.curvature.theta_h = 1.0;
   EXPECT_TRUE(links_of(segment_scene(curved_objects()), curved_objects(), strict).empty());
 }
+
+TEST(Curvature, SameDecisionsAtVga) {
+  // Every threshold is physical or scaled with the resolution: 640x480 decides as 320x240 does.
+  auto at_vga = [](TestScene scene) {
+    scene.camera = synth::default_camera(640, 480);
+    return scene;
+  };
+  const TestScene cup_scene = at_vga(cup()), curved = at_vga(curved_objects()), coaxial = at_vga(coaxial_cylinders());
+  const Segmented c = segment_scene(cup_scene);
+  const auto cup_links = links_of(c, cup_scene);
+  ASSERT_EQ(cup_links.size(), 1u);
+  EXPECT_EQ(cup_links[0].cue, Cue::CurvatureOpen);
+  const Segmented o = segment_scene(curved);
+  const auto parts = patches_on(o, 1);
+  const auto links = links_of(o, curved);
+  ASSERT_EQ(parts.size(), 2u);
+  ASSERT_EQ(links.size(), 1u);
+  EXPECT_EQ(links[0].pair, PatchPair(std::min(parts[0], parts[1]), std::max(parts[0], parts[1])));
+  EXPECT_EQ(links[0].cue, Cue::CurvatureOccluded);
+  EXPECT_TRUE(links_of(segment_scene(coaxial), coaxial).empty());
+}
