@@ -248,10 +248,11 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
     }
   if (similar.empty()) return out;
 
-  const int gap = std::max(1, static_cast<int>(std::lround(p.neighbour_gap_px * resolution_scale(assigned_labels.cols))));
+  const PixelScale px(camera.fx, camera.fy);
+  const int gap = px.length(p.neighbour_gap_px);
   // Edge pixels join a patch only within the adjacency radius of its core pixels (paper d), so the
   // core box grown by that radius holds all of the patch's assigned pixels.
-  const int assign_radius = static_cast<int>(std::ceil(params.adjacency.radius_px * resolution_scale(assigned_labels.cols)));
+  const int assign_radius = px.length(params.adjacency.radius_px);
   auto box_of = [&](const Patch& patch) { return grown(patch.bbox, assign_radius); };
   std::vector<int> convex(patches.size(), 2);  // 2 = not computed yet
   auto convexity_of = [&](int i) {
