@@ -13,11 +13,26 @@ namespace clutterseg::baselines {
 
 namespace {
 
-// Segments that are large planes (table, walls): at least min_px pixels, and inlier_share of them within
-// `distance` of their least-squares plane. The plane-size rule is the organized baseline's, so both
-// baselines drop the same kind of surface for the objects-only comparison.
+// Least-squares plane (unit normal, point on it) of the points idx, by PCA.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_plane(const pcl::PointCloud<PointT>& cloud, const std::vector<int>& idx) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i : idx) mean += cloud[i].getVector3fMap().cast<double>();
+  mean /= static_cast<double>(idx.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i : idx) {
+    const Eigen::Vector3d d = cloud[i].getVector3fMap().cast<double>() - mean;
+    cov += d * d.transpose();
+  }
+  return {Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0), mean};
+}
+
+// Segments that are mainly a large plane (table, walls): the plane fitted to the segment and refitted to
+// its own inliers (within plane_distance) a few times, so that objects LCCP merged into the table do not
+// tilt it, holds at least plane_min_px points and plane_inlier_share of the segment. The plane size and
+// distance are the organized baseline's, so both baselines drop the same kind of surface.
 void drop_planar_segments(cv::Mat& labels, const pcl::PointCloud<PointT>& cloud, const LccpParams& p) {
-  const int min_px = scaled_px(p.plane_min_px, labels.size());
+  constexpr int kRefits = 5;
+  const size_t min_px = static_cast<size_t>(scaled_px(p.plane_min_px, labels.size()));
   double max_label = 0;
   cv::minMaxLoc(labels, nullptr, &max_label);
   const int count = static_cast<int>(max_label);
@@ -26,20 +41,17 @@ void drop_planar_segments(cv::Mat& labels, const pcl::PointCloud<PointT>& cloud,
     if (int l = labels.at<int>(i); l > 0) members[l].push_back(i);
   for (int l = 1; l <= count; ++l) {
     const auto& idx = members[l];
-    if (static_cast<int>(idx.size()) < min_px) continue;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : idx) mean += cloud[i].getVector3fMap().cast<double>();
-    mean /= static_cast<double>(idx.size());
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (int i : idx) {
-      const Eigen::Vector3d d = cloud[i].getVector3fMap().cast<double>() - mean;
-      cov += d * d.transpose();
+    if (idx.size() < min_px) continue;
+    std::vector<int> inliers = idx;
+    for (int round = 0; round < kRefits && inliers.size() >= min_px; ++round) {
+      const auto [normal, origin] = fit_plane(cloud, inliers);
+      std::vector<int> next;
+      for (int i : idx)
+        if (std::abs(normal.dot(cloud[i].getVector3fMap().cast<double>() - origin)) <= p.plane_distance) next.push_back(i);
+      if (next == inliers) break;
+      inliers = std::move(next);
     }
-    const Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
-    size_t inliers = 0;
-    for (int i : idx)
-      if (std::abs(normal.dot(cloud[i].getVector3fMap().cast<double>() - mean)) <= p.plane_distance) ++inliers;
-    if (inliers >= p.plane_inlier_share * idx.size())
+    if (inliers.size() >= min_px && inliers.size() >= p.plane_inlier_share * idx.size())
       for (int i : idx) labels.at<int>(i) = 0;
   }
 }

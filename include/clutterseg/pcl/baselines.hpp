@@ -27,14 +27,14 @@ struct LccpParams {
   bool extended_convexity = false;      // k factor 1 instead of 0 (example: off unless -ec)
   bool sanity_criterion = false;        // example: off unless -sc
   unsigned min_segment_size = 0;        // merge smaller segments [supervoxels] (example: 0)
-  // Objects-only view (ours; the example labels every segment): a segment is dropped as table, wall
-  // or other large plane when it has at least plane_min_px pixels (at 640x480, scaled with image
-  // area; the organized baseline's plane size) and plane_inlier_share of its points lie within
-  // plane_distance of its least-squares plane.
+  // Objects-only view (ours; the example labels every segment): a segment is dropped as table, wall or
+  // other large plane when the plane fitted robustly to it holds at least plane_min_px of its pixels (at
+  // 640x480, scaled with image area; the organized baseline's plane size) within plane_distance, and at
+  // least plane_inlier_share of the segment.
   bool drop_planes = true;
   int plane_min_px = 10000;             // [px at 640x480]
   double plane_distance = 0.02;         // [m]
-  double plane_inlier_share = 0.9;      // [-]
+  double plane_inlier_share = 0.5;      // [-]
 };
 
 // Organized multi-plane segmentation + Euclidean clusters with the planes excluded (Trevor et al.,
