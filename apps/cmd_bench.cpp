@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <time.h>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -38,6 +39,7 @@ struct Runner {
   int threads = 1;
   Method method;
   std::vector<double> frame_ms;                         // wall time of each timed call
+  std::vector<double> cpu_ms;                           // CPU time of the calling thread (1-thread runs)
   std::map<std::string, std::vector<double>> stage_ms;  // the method's own per-stage times
   std::vector<std::string> stage_order;
   int failures = 0;
@@ -91,8 +93,16 @@ void use_threads(int threads) {
   cv::setNumThreads(threads == 1 ? 0 : threads);  // 0 = OpenCV runs sequentially
 }
 
+// CPU time of the calling thread: on a shared machine it leaves out the time the thread waited for a core.
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
 void run_once(Runner& r, const Frame& frame, bool timed) {
   use_threads(r.threads);
+  const double cpu_start = thread_cpu_ms();
   const auto start = std::chrono::steady_clock::now();
   MethodOutput out;
   try {
@@ -103,8 +113,10 @@ void run_once(Runner& r, const Frame& frame, bool timed) {
     return;
   }
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double cpu = thread_cpu_ms() - cpu_start;
   if (!timed) return;
   r.frame_ms.push_back(ms);
+  if (r.threads == 1) r.cpu_ms.push_back(cpu);
   for (const auto& [stage, t] : out.timings_ms) {
     if (!r.stage_ms.count(stage)) r.stage_order.push_back(stage);
     r.stage_ms[stage].push_back(t);
@@ -132,15 +144,20 @@ std::string report(const BenchOptions& o, const std::vector<Runner>& runners, co
   md << "- date: " << utc_now() << "\n";
   md << "- machine: " << cores << " cores (nproc), " << cpu_model() << "\n";
   md << "- frames: " << frames.size() << " of " << frames.front().depth.cols << "x" << frames.front().depth.rows
-     << ", " << passes << " pass(es) timed after " << o.warmup << " warm-up frame(s) per method\n\n";
-  md << "| method | threads | frames | median [ms] | p95 [ms] | median / clutterseg |\n";
-  md << "|---|---:|---:|---:|---:|---:|\n";
+     << ", " << passes << " pass(es) timed after " << o.warmup << " warm-up frame(s) per method\n";
+  md << "- times are wall-clock per frame (load, I/O excluded); CPU = CPU time of the calling thread, for one-thread "
+        "runs only (all their work runs on that thread)\n\n";
+  const double ref_cpu = percentile(reference.cpu_ms, 0.5);
+  md << "| method | threads | frames | median [ms] | p95 [ms] | median / clutterseg | CPU median [ms] | CPU / clutterseg |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Runner& r : runners) {
     const double median = percentile(r.frame_ms, 0.5);
     md << "| " << r.label << " | " << r.threads << " | " << r.frame_ms.size()
        << (r.failures ? " (" + std::to_string(r.failures) + " failed)" : std::string()) << " | " << fmt(median)
        << " | " << fmt(percentile(r.frame_ms, 0.95)) << " | ";
-    md << (ref_median > 0 && !std::isnan(median) ? fmt(median / ref_median) + "x" : std::string("-")) << " |\n";
+    md << (ref_median > 0 && !std::isnan(median) ? fmt(median / ref_median) + "x" : std::string("-")) << " | ";
+    const double cpu = percentile(r.cpu_ms, 0.5);
+    md << fmt(cpu) << " | " << (ref_cpu > 0 && !std::isnan(cpu) ? fmt(cpu / ref_cpu) + "x" : std::string("-")) << " |\n";
   }
   // clutterseg per stage, single- and multi-threaded side by side.
   std::vector<const Runner*> ours;
@@ -161,6 +178,16 @@ std::string report(const BenchOptions& o, const std::vector<Runner>& runners, co
     }
     md << "\n";
   }
+  // The peers' own stages, so that one sees where their time goes.
+  for (const Runner& r : runners) {
+    if (r.method.name == "clutterseg" || r.stage_order.empty()) continue;
+    md << "\n" << r.label << " per stage [ms], " << r.threads << " thread" << (r.threads == 1 ? "" : "s")
+       << ":\n\n| stage | median | p95 |\n|---|---:|---:|\n";
+    for (const auto& stage : r.stage_order) {
+      const auto& v = r.stage_ms.at(stage);
+      md << "| " << stage << " | " << fmt(percentile(v, 0.5)) << " | " << fmt(percentile(v, 0.95)) << " |\n";
+    }
+  }
   return md.str();
 }
 
@@ -174,7 +201,11 @@ int run(const BenchOptions& o) {
   auto add = [&](const std::string& name, int t) {
     Params p = params;
     p.threads = t;
-    runners.push_back({name, t, make_method(name, p), {}, {}, {}, 0});
+    Runner r;
+    r.label = name;
+    r.threads = t;
+    r.method = make_method(name, p);
+    runners.push_back(std::move(r));
   };
   add("clutterseg", threads);
   const int multi = threads == 1 ? cores : 1;  // the other thread count for the per-stage table
