@@ -38,7 +38,7 @@ struct LccpParams {
 };
 
 // Organized multi-plane segmentation + Euclidean clusters with the planes excluded (Trevor et al.,
-// "Efficient organized point cloud segmentation with connected components", SRMS 2013), with the
+// "Efficient organized point cloud segmentation with connected components", SPME workshop 2013), with the
 // settings of PCL's apps/src/organized_segmentation_demo.cpp.
 struct OrganizedParams {
   double max_depth_change_factor = 0.02;  // integral-image normals: depth change that breaks smoothing [m]
