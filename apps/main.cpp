@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "clutterseg 0.1.0");
   app::add_segment_command(app);
   app::add_eval_command(app);
+  app::add_bench_command(app);
   try {
     app.parse(argc, argv);
     if (dump_config) {
