@@ -34,7 +34,7 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
 namespace {
 
 // One row of raw normals. Plain pointers and values (no captures) so that the loop vectorises.
-void raw_normal_row(const float* __restrict up, const float* __restrict mid, const float* __restrict down,
+CLUTTERSEG_ROW_KERNEL void raw_normal_row(const float* __restrict up, const float* __restrict mid, const float* __restrict down,
                     const float* __restrict rx, float ry, float ry_up, float ry_down, int cols, int s,
                     float jump_limit, float* __restrict nx, float* __restrict ny, float* __restrict nz) {
   for (int x = 0; x < cols; ++x) {
@@ -63,6 +63,18 @@ void raw_normal_row(const float* __restrict up, const float* __restrict mid, con
   }
 }
 
+// Renormalises one row of smoothed normals; 0 where there is no measurement.
+CLUTTERSEG_ROW_KERNEL void normalize_row(const float* __restrict z, int cols, float* __restrict nx,
+                                         float* __restrict ny, float* __restrict nz) {
+  for (int x = 0; x < cols; ++x) {
+    const float len2 = nx[x] * nx[x] + ny[x] * ny[x] + nz[x] * nz[x];
+    const float inv = ((z[x] > 0) & (len2 > 1e-12f)) ? 1.f / std::sqrt(len2) : 0.f;
+    nx[x] *= inv;
+    ny[x] *= inv;
+    nz[x] *= inv;
+  }
+}
+
 }  // namespace
 
 cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit) {
@@ -84,19 +96,8 @@ cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, in
   if (ksize > 1)
     for (auto& p : planes) cv::GaussianBlur(p, p, cv::Size(ksize, ksize), 0, 0, cv::BORDER_REPLICATE);
   parallel_for_rows(rows, [&](int begin, int end) {
-    for (int y = begin; y < end; ++y) {
-      const float* z = depth.ptr<float>(y);
-      float* nx = planes[0].ptr<float>(y);
-      float* ny = planes[1].ptr<float>(y);
-      float* nz = planes[2].ptr<float>(y);
-      for (int x = 0; x < cols; ++x) {
-        const float len2 = nx[x] * nx[x] + ny[x] * ny[x] + nz[x] * nz[x];
-        const float inv = ((z[x] > 0) & (len2 > 1e-12f)) ? 1.f / std::sqrt(len2) : 0.f;
-        nx[x] *= inv;
-        ny[x] *= inv;
-        nz[x] *= inv;
-      }
-    }
+    for (int y = begin; y < end; ++y)
+      normalize_row(depth.ptr<float>(y), cols, planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
   });
   cv::Mat normals;
   cv::merge(planes, 3, normals);

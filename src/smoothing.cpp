@@ -57,6 +57,21 @@ cv::Mat median_depth(const cv::Mat& depth) {
   return out;
 }
 
+namespace {
+
+// sum += v and count += 1 where v is a measurement within band_k * z^2 of the newest value z.
+CLUTTERSEG_ROW_KERNEL void accumulate_within_band(const float* __restrict v, const float* __restrict newest, int cols,
+                                                  float band_k, float* __restrict sum, float* __restrict count) {
+  for (int x = 0; x < cols; ++x) {
+    const float z = newest[x];
+    const bool take = (v[x] > 0) & (std::abs(v[x] - z) <= band_k * z * z);
+    sum[x] += take ? v[x] : 0.f;
+    count[x] += take ? 1.f : 0.f;
+  }
+}
+
+}  // namespace
+
 cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& params) {
   if (!window_.empty() && window_.back().size() != depth.size()) window_.clear();
   window_.push_back(depth.clone());
@@ -76,15 +91,8 @@ cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& pa
       std::fill(sum, sum + depth.cols, 0.f);
       std::fill(count.begin(), count.end(), 0.f);
       // Frame by frame over whole rows, branch-free, so that it vectorises.
-      for (int i = 0; i < n; ++i) {
-        const float* v = frames[static_cast<size_t>(i)]->ptr<float>(y);
-        for (int x = 0; x < depth.cols; ++x) {
-          const float z = newest[x];
-          const bool take = (v[x] > 0) & (std::abs(v[x] - z) <= band_k * z * z);
-          sum[x] += take ? v[x] : 0.f;
-          count[static_cast<size_t>(x)] += take ? 1.f : 0.f;
-        }
-      }
+      for (int i = 0; i < n; ++i)
+        accumulate_within_band(frames[static_cast<size_t>(i)]->ptr<float>(y), newest, depth.cols, band_k, sum, count.data());
       // The newest value is within its own band, so count >= 1 wherever it is valid.
       for (int x = 0; x < depth.cols; ++x) sum[x] = newest[x] > 0 ? sum[x] / count[static_cast<size_t>(x)] : 0.f;
     }
