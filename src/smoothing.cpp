@@ -59,11 +59,11 @@ cv::Mat median_depth(const cv::Mat& depth) {
 
 namespace {
 
-// sum += v and count += 1 where v is a measurement within band_k * z^2 of the newest value z.
-CLUTTERSEG_ROW_KERNEL void accumulate_within_band(const float* __restrict v, const float* __restrict newest, int cols,
+// sum += v and count += 1 where v is a measurement within band_k * z^2 of the centre z.
+CLUTTERSEG_ROW_KERNEL void accumulate_within_band(const float* __restrict v, const float* __restrict centre, int cols,
                                                   float band_k, float* __restrict sum, float* __restrict count) {
   for (int x = 0; x < cols; ++x) {
-    const float z = newest[x];
+    const float z = centre[x];
     const bool take = (v[x] > 0) & (std::abs(v[x] - z) <= band_k * z * z);
     sum[x] += take ? v[x] : 0.f;
     count[x] += take ? 1.f : 0.f;
@@ -84,17 +84,24 @@ cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& pa
   for (const auto& f : window_) frames.push_back(&f);
   const float band_k = static_cast<float>(params.temporal_band);
   parallel_for_rows(depth.rows, [&](int begin, int end) {
-    std::vector<float> count(static_cast<size_t>(depth.cols));
+    const size_t cols = static_cast<size_t>(depth.cols);
+    std::vector<float> sum(cols), count(cols), centre(cols);
     for (int y = begin; y < end; ++y) {
       const float* newest = frames.back()->ptr<float>(y);
-      float* sum = out.ptr<float>(y);
-      std::fill(sum, sum + depth.cols, 0.f);
-      std::fill(count.begin(), count.end(), 0.f);
-      // Frame by frame over whole rows, branch-free, so that it vectorises.
-      for (int i = 0; i < n; ++i)
-        accumulate_within_band(frames[static_cast<size_t>(i)]->ptr<float>(y), newest, depth.cols, band_k, sum, count.data());
-      // The newest value is within its own band, so count >= 1 wherever it is valid.
-      for (int x = 0; x < depth.cols; ++x) sum[x] = newest[x] > 0 ? sum[x] / count[static_cast<size_t>(x)] : 0.f;
+      float* o = out.ptr<float>(y);
+      // Two passes: the band around the newest value finds the values of the same surface (moving
+      // surfaces keep only the newest), then the band around their mean, a steadier centre than one
+      // noisy sample, takes the whole static run, so the noise falls by about sqrt(n).
+      for (int pass = 0; pass < 2; ++pass) {
+        const float* around = pass == 0 ? newest : centre.data();
+        std::fill(sum.begin(), sum.end(), 0.f);
+        std::fill(count.begin(), count.end(), 0.f);
+        for (int i = 0; i < n; ++i)
+          accumulate_within_band(frames[static_cast<size_t>(i)]->ptr<float>(y), around, depth.cols, band_k, sum.data(),
+                                 count.data());
+        float* mean = pass == 0 ? centre.data() : o;
+        for (size_t x = 0; x < cols; ++x) mean[x] = newest[x] > 0 ? sum[x] / std::max(count[x], 1.f) : 0.f;
+      }
     }
   });
   return out;

@@ -16,8 +16,8 @@ struct Params {
     bool median = true;          // 3x3 median on depth, invalid pixels ignored and kept invalid
     bool temporal = true;        // motion-sensitive temporal smoothing (Segmenter only; stateful)
     int temporal_frames = 6;     // n: window length [frames]
-    double temporal_band = 0.003;  // k [1/m]: values within k*z^2 of the newest are averaged
-                                   // (Kinect v1: 10 raw disparity units ~ 3 mm at 1 m, grows with z^2)
+    double temporal_band = 0.01;   // k [1/m]: values within k*z^2 of the newest are averaged
+                                   // (10 mm at 1 m: 5 sigma of Kinect v1 axial noise; docs/PRESEGMENTATION.md)
   } smoothing;
 
   // a) Normals by cross product of image neighbours on the organized 3D points, then Gaussian-smoothed.
