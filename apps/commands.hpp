@@ -6,5 +6,6 @@
 namespace clutterseg::app {
 
 void add_segment_command(CLI::App& app);
+void add_synth_command(CLI::App& app);
 
 }  // namespace clutterseg::app

@@ -1,5 +1,6 @@
 #include "clutterseg/synth/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -173,12 +174,11 @@ RayCaster::RayCaster(const Scene& scene, const Camera& camera, const Eigen::Isom
     const Shape& s = scene.shapes[i];
     const Eigen::Isometry3d shape_to_view = scene_to_view * s.pose;
     const Eigen::Isometry3d view_to_shape = shape_to_view.inverse();
-    shapes_.push_back({&s, view_to_shape.linear(), view_to_shape * origin, shape_to_view.linear()});
-    all_.push_back(static_cast<int>(i));
-    // Conservative image rectangle of the bounding sphere seen from `origin`: every point of the sphere
-    // has x <= c.x + r and z >= c.z - r, so its image lies within the bounds below.
     const double r = bounding_radius(s);
     const Vector3d c = shape_to_view.translation() - origin;
+    shapes_.push_back({&s, view_to_shape.linear(), view_to_shape * origin, shape_to_view.linear(), c, r});
+    // Conservative image rectangle of the bounding sphere seen from `origin`: every point of the sphere
+    // has x <= c.x + r and z >= c.z - r, so its image lies within the bounds below.
     int tx0 = 0, tx1 = tiles_x_ - 1, ty0 = 0, ty1 = tiles_y_ - 1;
     if (std::isfinite(r) && c.z() - r > 1e-3) {
       auto bound = [&](double centre, double f, double pc, bool upper) {
@@ -197,13 +197,25 @@ RayCaster::RayCaster(const Scene& scene, const Camera& camera, const Eigen::Isom
     for (int ty = ty0; ty <= ty1; ++ty)
       for (int tx = tx0; tx <= tx1; ++tx) tiles_[static_cast<size_t>(ty) * tiles_x_ + tx].push_back(static_cast<int>(i));
   }
+  // Nearest bounding spheres first, so that a close hit lets the far shapes be skipped.
+  auto nearest = [&](int a, int b) {
+    const Local &la = shapes_[static_cast<size_t>(a)], &lb = shapes_[static_cast<size_t>(b)];
+    const double da = std::isfinite(la.radius) ? la.centre.norm() - la.radius : 1e300;
+    const double db = std::isfinite(lb.radius) ? lb.centre.norm() - lb.radius : 1e300;
+    return da < db || (da == db && a < b);
+  };
+  for (size_t i = 0; i < shapes_.size(); ++i) all_.push_back(static_cast<int>(i));
+  std::sort(all_.begin(), all_.end(), nearest);
+  for (auto& tile : tiles_) std::sort(tile.begin(), tile.end(), nearest);
 }
 
 Vector3d RayCaster::pixel_ray(double u, double v) const {
   return Vector3d((u - camera_.cx) / camera_.fx, (v - camera_.cy) / camera_.fy, 1.0).normalized();
 }
 
-int RayCaster::cast(const Vector3d& dir, double u, double v, double max_t, double& t, Vector3d& normal) const {
+bool is_convex(const Shape& s) { return s.type != ShapeType::Cup && s.type != ShapeType::Bowl; }
+
+int RayCaster::cast(const Vector3d& dir, double u, double v, double max_t, double& t, Vector3d& normal, int ignore) const {
   const std::vector<int>* candidates = &all_;
   if (std::isfinite(u) && std::isfinite(v)) {
     const double fx = std::floor((u + margin_) / tile_), fy = std::floor((v + margin_) / tile_);
@@ -214,7 +226,14 @@ int RayCaster::cast(const Vector3d& dir, double u, double v, double max_t, doubl
   double best_t = max_t;
   Vector3d best_n = Vector3d::Zero();
   for (int i : *candidates) {
+    if (i == ignore) continue;
     const Local& l = shapes_[static_cast<size_t>(i)];
+    if (std::isfinite(l.radius)) {
+      // Bounding sphere: the ray misses it, or cannot reach it before the best hit so far.
+      const double b = dir.dot(l.centre);
+      if (b + l.radius < 0 || b - l.radius >= best_t) continue;
+      if (l.centre.squaredNorm() - b * b > l.radius * l.radius) continue;
+    }
     Hit hit;
     intersect_local(*l.shape, l.origin, l.to_shape * dir, hit);
     if (hit.valid() && hit.t < best_t) { best_t = hit.t; best = i; best_n = hit.n; }

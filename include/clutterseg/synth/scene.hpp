@@ -49,6 +49,9 @@ bool intersect(const Shape& shape, const Eigen::Vector3d& origin, const Eigen::V
 // Radius of a sphere about the shape's origin that holds the whole shape (+inf for an unbounded plane).
 double bounding_radius(const Shape& shape);
 
+// Plane, Box, Cylinder, Sphere: a surface point facing a viewpoint is never hidden from it by its own shape.
+bool is_convex(const Shape& shape);
+
 // Nearest hit of many rays from one viewpoint with a scene: shapes are moved into the viewpoint's frame
 // once, and each ray only tests the shapes whose projected bounding sphere covers its image tile.
 class RayCaster {
@@ -59,8 +62,9 @@ class RayCaster {
   RayCaster(const Scene& scene, const Camera& camera, const Eigen::Isometry3d& scene_to_view,
             const Eigen::Vector3d& origin = Eigen::Vector3d::Zero(), int margin_px = 0);
   // Nearest hit with t in (0, max_t) along the unit direction `dir` (view frame) whose image point
-  // is (u, v) as seen from `origin`; returns the shape index or -1.
-  int cast(const Eigen::Vector3d& dir, double u, double v, double max_t, double& t, Eigen::Vector3d& normal) const;
+  // is (u, v) as seen from `origin`; returns the shape index or -1. Shape `ignore` is not tested.
+  int cast(const Eigen::Vector3d& dir, double u, double v, double max_t, double& t, Eigen::Vector3d& normal,
+           int ignore = -1) const;
   // The ray through pixel (u, v) of the camera image, from `origin` (unit, view frame).
   Eigen::Vector3d pixel_ray(double u, double v) const;
   const Camera& camera() const { return camera_; }
@@ -71,6 +75,8 @@ class RayCaster {
     Eigen::Matrix3d to_shape;     // rotation view -> shape
     Eigen::Vector3d origin;       // ray origin in the shape frame
     Eigen::Matrix3d to_view;      // rotation shape -> view (for normals)
+    Eigen::Vector3d centre;       // bounding sphere centre relative to the ray origin (view frame)
+    double radius;                // bounding sphere radius (+inf: unbounded)
   };
   std::vector<Local> shapes_;
   Camera camera_;
