@@ -286,9 +286,10 @@ bool place_occluder(std::vector<Item>& items, int behind, const Layout& lay, Rng
   for (int attempt = 0; attempt < 10; ++attempt) {
     const double d = depth + w * 0.75 + rng.uniform(0.01, 0.04);
     // Similar triangles from the eye over the occluder's top down to the height cover * top at `behind`.
-    const double eye_height = lay.eye.z(), reach = (lay.eye.head<2>() - back.footprint.centre).norm();
-    const double aim = cover * back.top;
-    const double h = std::clamp((aim * (reach - d) + eye_height * d) / std::max(reach, 1e-3), back.top * 1.1, 0.4);
+    // Aim at the far side of `behind`, so that its top face is hidden too.
+    const double eye_height = lay.eye.z(), reach = (lay.eye.head<2>() - back.footprint.centre).norm() + depth;
+    const double aim = cover * back.top, run = d + depth;
+    const double h = std::clamp((aim * (reach - run) + eye_height * run) / std::max(reach, 1e-3), back.top * 1.1, 0.45);
     occ.shape.size = {w / 2, w / 2, h / 2};
     occ.info.size = {w, w, h};
     occ.footprint.half = {w / 2, w / 2};
