@@ -51,6 +51,8 @@ int run(const SynthOptions& o, bool size_given) {
   d.overwrite = o.overwrite;
   d.preview = o.preview;
   synth::preset_info(d.preset);
+  // Frames are rendered in parallel already; OpenCV's own thread pool inside each frame only adds overhead.
+  cv::setNumThreads(1);
   Progress progress("synth", static_cast<size_t>(std::max(o.frames, 0)));
   synth::write_dataset(d, [&](const std::string& name) { progress.step(name); });
   return 0;

@@ -139,7 +139,7 @@ void write_dataset(const DatasetOptions& o, const std::function<void(const std::
       write_png_fast(o.out / "label" / (name + ".png"), labels_to_u16(f.sensor.labels));
       write_png_fast(o.out / "color" / (name + ".png"), f.sensor.color);
       frames[static_cast<size_t>(i)] = frame_json(name, f);
-      if (i < preview_count) previews[static_cast<size_t>(i)] = preview_image(f.sensor);
+      if (i < preview_count) previews[static_cast<size_t>(i)] = preview_image(f.sensor, 160);
       std::lock_guard<std::mutex> lock(mutex);
       if (on_frame) on_frame(name);
     } catch (const std::exception& e) {

@@ -94,6 +94,7 @@ SensorModel sensor_model(Sensor sensor, int image_width) {
       m.max_depth_m = 4.0;
       m.lateral_px = 0.8 * scale;
       m.lateral_slope_px = 0.035 * scale;
+      m.lateral_block_px = 3 * scale;
       m.grazing_start_deg = 75;
       m.grazing_end_deg = 88;
       m.correlation_px = 1.0 * scale;
@@ -108,6 +109,7 @@ SensorModel sensor_model(Sensor sensor, int image_width) {
       m.max_depth_m = 10.0;
       m.stereo = true;
       m.lateral_px = 0.5 * scale;
+      m.lateral_block_px = 2 * scale;
       m.grazing_start_deg = 75;
       m.grazing_end_deg = 88;
       m.correlation_px = 1.0 * scale;
@@ -198,7 +200,7 @@ SensorFrame simulate(const Scene& scene, const Camera& camera, const Eigen::Isom
           if (shadowed) out.shadow.at<uchar>(v, u) = 255;
           cos_in = std::min(cos_in, cos_second);
         }
-        incidence[static_cast<size_t>(i)] = static_cast<float>(std::acos(std::clamp(cos_in, 0.0, 1.0)));
+        incidence[static_cast<size_t>(i)] = std::acos(std::clamp(static_cast<float>(cos_in), 0.f, 1.f));
       }
   });
 
@@ -217,6 +219,7 @@ SensorFrame simulate(const Scene& scene, const Camera& camera, const Eigen::Isom
     cv::erode(surface_id, id_min, window);
     const cv::Mat field = noise_field(W, H, model.correlation_px, mix_seed(seed, 11));
     const double F = model.disparity_focal_px * model.baseline_m;  // disparity [px] = F / z
+    const int lateral_block = std::max(1, static_cast<int>(std::lround(model.lateral_block_px)));
     const double grazing0 = model.grazing_start_deg * M_PI / 180, grazing1 = model.grazing_end_deg * M_PI / 180;
     parallel_for_rows(H, [&](int begin, int end) {
       for (int v = begin; v < end; ++v)
@@ -224,9 +227,11 @@ SensorFrame simulate(const Scene& scene, const Camera& camera, const Eigen::Isom
           const int i = v * W + u;
           int src = i;
           if (id_max.at<float>(i) != id_min.at<float>(i)) {
+            // One offset per block of pixels: real edges fray in blocks (the matching window), not per pixel.
+            const int block = (v / lateral_block) * W + u / lateral_block;
             const double sigma = model.lateral_sigma_px(incidence[static_cast<size_t>(i)]);
-            const int du = static_cast<int>(std::lround(std::clamp(sigma * box_muller(pixel_hash(seed, i, kLateralU), pixel_hash(seed, i, kLateralV)), -2.0, 2.0)));
-            const int dv = static_cast<int>(std::lround(std::clamp(sigma * box_muller(pixel_hash(seed, i, kLateralV), pixel_hash(seed, i, kLateralU)), -2.0, 2.0)));
+            const int du = static_cast<int>(std::lround(std::clamp(sigma * box_muller(pixel_hash(seed, block, kLateralU), pixel_hash(seed, block, kLateralV)), -2.0, 2.0)));
+            const int dv = static_cast<int>(std::lround(std::clamp(sigma * box_muller(pixel_hash(seed, block, kLateralV), pixel_hash(seed, block, kLateralU)), -2.0, 2.0)));
             src = std::clamp(v + dv, 0, H - 1) * W + std::clamp(u + du, 0, W - 1);
           }
           const float z_true = out.true_depth.at<float>(src);

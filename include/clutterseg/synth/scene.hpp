@@ -81,7 +81,7 @@ class RayCaster {
   std::vector<Local> shapes_;
   Camera camera_;
   Eigen::Vector3d origin_;
-  int margin_ = 0, tile_ = 16, tiles_x_ = 0, tiles_y_ = 0;
+  int margin_ = 0, tile_ = 8, tiles_x_ = 0, tiles_y_ = 0;
   std::vector<std::vector<int>> tiles_;  // shape indices per tile
   std::vector<int> all_;
 };

@@ -29,6 +29,7 @@ struct SensorModel {
   bool stereo = false;            // the second view is a camera: it must also see the point in its image
   double lateral_px = 0;          // lateral noise at depth edges, at normal incidence [px at this width]
   double lateral_slope_px = 0;    // ... growing by this times theta / (pi/2 - theta) [px]
+  double lateral_block_px = 1;    // pixels in a square block share one lateral offset [px]
   double grazing_start_deg = 90;  // dropouts start at this incidence angle to camera or projector [deg]
   double grazing_end_deg = 90;    // ... and every pixel is missing from this angle on [deg]
   double correlation_px = 0;      // Gaussian correlation length of the noise field [px at this width]
