@@ -71,7 +71,7 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--sensor", o->sensor, "kinect-v1 (default), realsense-d435 or ideal");
   cmd->add_option("--camera", o->camera_file, "intrinsics JSON {fx, fy, cx, cy, width, height}")->check(CLI::ExistingFile);
   cmd->add_option("--threads", o->threads, "threads (0 = all cores); the output does not depend on it");
-  cmd->add_option("--preview", o->preview, "also write a montage PNG of the first 4 frames (depth colour-mapped, objects outlined)");
+  cmd->add_option("--preview", o->preview, "also write a PNG of the first two frames (depth colour-mapped, objects outlined)");
   cmd->add_flag("--overwrite", o->overwrite, "write into a non-empty folder, replacing an earlier dataset");
   cmd->add_flag("--list", o->list, "print the presets and exit");
   cmd->callback([o, size] {

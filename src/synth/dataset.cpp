@@ -120,7 +120,7 @@ void write_dataset(const DatasetOptions& o, const std::function<void(const std::
   write_text_atomic(o.out / "camera.json", camera_json(o.camera, o.sensor));
 
   std::vector<json> frames(static_cast<size_t>(o.frames));
-  const int preview_count = o.preview.empty() ? 0 : std::min(o.frames, 4);
+  const int preview_count = o.preview.empty() ? 0 : std::min(o.frames, 2);
   std::vector<cv::Mat> previews(static_cast<size_t>(preview_count));
   std::mutex mutex;
   std::string first_error;
@@ -163,7 +163,9 @@ void write_dataset(const DatasetOptions& o, const std::function<void(const std::
     }
     cv::Mat montage;
     cv::vconcat(rows, montage);
-    write_png_atomic(o.preview, montage);
+    std::vector<uchar> bytes;  // maximum compression: previews go into documentation
+    if (!cv::imencode(".png", montage, bytes, {cv::IMWRITE_PNG_COMPRESSION, 9})) throw Error(o.preview.string() + ": cannot be encoded");
+    write_text_atomic(o.preview, std::string(bytes.begin(), bytes.end()));
   }
 }
 

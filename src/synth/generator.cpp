@@ -474,14 +474,15 @@ GeneratedScene generate_scene(const std::string& preset, std::uint64_t seed, int
     lay.eye = out.eye;
     out.world_to_camera = look_at(out.eye, out.target);
     if (!build(preset, items, lay, rng, frame)) continue;
-    // Every object's centre in the image, and the camera clear of every object.
+    // Every object's centre in the image.
     bool ok = true;
     for (const Item& it : items) {
       if (sequence && &it == &items.back()) continue;  // the sliding box stays within the region
       const Vector3d c = out.world_to_camera * it.info.pose.translation();
       const double u = camera.cx + camera.fx * c.x() / c.z(), v = camera.cy + camera.fy * c.y() / c.z();
       if (c.z() <= 0.2 || u < 0.05 * camera.width || u > 0.95 * camera.width || v < 0.05 * camera.height || v > 0.95 * camera.height) ok = false;
-      if ((out.eye - it.info.pose.translation()).norm() < bounding_radius(it.shape) + 0.15) ok = false;
+      // At least 0.5 m from the camera (the Kinect's minimum range), so no object is lost entirely.
+      if ((out.eye - it.info.pose.translation()).norm() < bounding_radius(it.shape) + 0.5) ok = false;
     }
     if (ok) break;
   }

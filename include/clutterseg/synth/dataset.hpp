@@ -29,7 +29,7 @@ struct DatasetOptions {
   Sensor sensor = Sensor::KinectV1;
   int threads = 0;          // 0 = all cores; the bytes written do not depend on it
   bool overwrite = false;   // write into a non-empty folder (replacing earlier frames)
-  std::filesystem::path preview;  // optional: a 2x2 montage of the first frames, 160 px wide each
+  std::filesystem::path preview;  // optional: the first two frames side by side, 160x120 each
 };
 
 // What a person looks at: the reported depth colour-mapped (black = no measurement) with every
