@@ -30,7 +30,7 @@ double box_muller(std::uint64_t h1, std::uint64_t h2) {
 }
 
 // Random streams per pixel: one hash each.
-enum Stream : std::uint64_t { kField = 1, kLateralU = 2, kLateralV = 3, kDropout = 4 };
+enum Stream : std::uint64_t { kField = 1, kLateralU = 2, kLateralV = 3, kDropout = 4, kShadowEdge = 5 };
 std::uint64_t pixel_hash(std::uint64_t seed, int index, Stream stream) {
   return mix_seed(seed, static_cast<std::uint64_t>(index) * 8 + stream);
 }
@@ -95,6 +95,7 @@ SensorModel sensor_model(Sensor sensor, int image_width) {
       m.lateral_px = 0.8 * scale;
       m.lateral_slope_px = 0.035 * scale;
       m.lateral_block_px = 3 * scale;
+      m.shadow_grow_px = 2 * scale;
       m.grazing_start_deg = 75;
       m.grazing_end_deg = 88;
       m.correlation_px = 1.0 * scale;
@@ -218,6 +219,10 @@ SensorFrame simulate(const Scene& scene, const Camera& camera, const Eigen::Isom
     cv::dilate(surface_id, id_max, window);
     cv::erode(surface_id, id_min, window);
     const cv::Mat field = noise_field(W, H, model.correlation_px, mix_seed(seed, 11));
+    // Pixels beside a shadow: the matching window reaches into it, and half of them fail too.
+    cv::Mat near_shadow;
+    const int grow = static_cast<int>(std::lround(model.shadow_grow_px));
+    if (grow > 0) cv::dilate(out.shadow, near_shadow, cv::Mat::ones(1, 2 * grow + 1, CV_8U));
     const double F = model.disparity_focal_px * model.baseline_m;  // disparity [px] = F / z
     const int lateral_block = std::max(1, static_cast<int>(std::lround(model.lateral_block_px)));
     const double grazing0 = model.grazing_start_deg * M_PI / 180, grazing1 = model.grazing_end_deg * M_PI / 180;
@@ -236,6 +241,7 @@ SensorFrame simulate(const Scene& scene, const Camera& camera, const Eigen::Isom
           }
           const float z_true = out.true_depth.at<float>(src);
           if (z_true <= 0 || out.shadow.at<uchar>(src)) continue;
+          if (grow > 0 && near_shadow.at<uchar>(src) && uniform01(pixel_hash(seed, i, kShadowEdge)) < 0.5) continue;
           // Dropouts at grazing angles to the camera or the projector.
           const double theta = incidence[static_cast<size_t>(src)];
           if (theta > grazing0) {

@@ -30,6 +30,7 @@ struct SensorModel {
   double lateral_px = 0;          // lateral noise at depth edges, at normal incidence [px at this width]
   double lateral_slope_px = 0;    // ... growing by this times theta / (pi/2 - theta) [px]
   double lateral_block_px = 1;    // pixels in a square block share one lateral offset [px]
+  double shadow_grow_px = 0;      // pixels this close (along rows) to a shadow drop out with p = 0.5 [px]
   double grazing_start_deg = 90;  // dropouts start at this incidence angle to camera or projector [deg]
   double grazing_end_deg = 90;    // ... and every pixel is missing from this angle on [deg]
   double correlation_px = 0;      // Gaussian correlation length of the noise field [px at this width]
