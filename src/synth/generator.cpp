@@ -1,8 +1,8 @@
 #include "clutterseg/synth/generator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <functional>
 #include <optional>
 #include <random>
 
@@ -233,6 +233,7 @@ struct Layout {
 };
 
 // Tries to place `it` on the table at a random free spot (or at `xy` when given); bounded attempts.
+// `gap`: clearance to the objects on the table [m]; -1 skips the check (touching boxes placed by construction).
 bool place_on_table(Item it, std::vector<Item>& items, const Layout& lay, Rng& rng, double gap,
                     const std::optional<Vector2d>& xy = std::nullopt, std::optional<double> yaw = std::nullopt) {
   for (int attempt = 0; attempt < (xy ? 1 : 80); ++attempt) {
