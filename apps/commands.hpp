@@ -8,5 +8,6 @@ namespace clutterseg::app {
 void add_segment_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_synth_command(CLI::App& app);
 
 }  // namespace clutterseg::app

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app::add_segment_command(app);
   app::add_eval_command(app);
   app::add_bench_command(app);
+  app::add_synth_command(app);
   try {
     app.parse(argc, argv);
     if (dump_config) {
