@@ -1,6 +1,251 @@
+// Per-object outputs: statistics, the support plane (table) and the objects-only view.
 #include "clutterseg/objects.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+
 namespace clutterseg {
+
+namespace {
+
+bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
+
+Eigen::Vector3d to_eigen(const cv::Vec3f& p) { return {p[0], p[1], p[2]}; }
+
+// Least-squares plane of a pixel list (at most ~3000 of them used), normal facing the camera.
+bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& plane) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / 3000);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  int n = 0;
+  for (size_t k = 0; k < pixels.size(); k += stride) {
+    if (!valid_point(pts[pixels[k]])) continue;
+    const Eigen::Vector3d q = to_eigen(pts[pixels[k]]);
+    sum += q;
+    outer += q * q.transpose();
+    ++n;
+  }
+  if (n < 10) return false;
+  const Eigen::Vector3d mean = sum / n;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / n - mean * mean.transpose());
+  if (eig.eigenvalues()(1) < 1e-8) return false;
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  if (normal.dot(mean) > 0) normal = -normal;
+  plane.normal = normal.cast<float>();
+  plane.offset = static_cast<float>(-normal.dot(mean));
+  return true;
+}
+
+// The visible region of a support candidate: convex hull of its points projected into the plane.
+struct PlaneRegion {
+  Plane plane;
+  Eigen::Vector3f u, v;          // orthonormal basis of the plane
+  std::vector<cv::Point2f> hull;  // in millimetres
+  cv::Point2f project(const Eigen::Vector3f& q) const { return {1000.f * u.dot(q), 1000.f * v.dot(q)}; }
+  // Signed distance to the hull in metres (> 0 inside).
+  double inside(const Eigen::Vector3f& q) const {
+    return hull.size() < 3 ? -1e9 : cv::pointPolygonTest(hull, project(q), true) / 1000.0;
+  }
+};
+
+PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points) {
+  PlaneRegion r;
+  r.plane = plane;
+  r.u = plane.normal.unitOrthogonal();
+  r.v = plane.normal.cross(r.u);
+  const auto* pts = points.ptr<cv::Vec3f>();
+  std::vector<cv::Point2f> projected;
+  const size_t stride = std::max<size_t>(1, pixels.size() / 4000);
+  for (size_t k = 0; k < pixels.size(); k += stride)
+    if (valid_point(pts[pixels[k]])) projected.push_back(r.project(to_eigen(pts[pixels[k]]).cast<float>()));
+  if (projected.size() >= 3) cv::convexHull(projected, r.hull);
+  return r;
+}
+
+// Pixels visited per object when classifying it against the table (a share is all we need).
+constexpr int kSamplesPerObject = 2000;
+
+struct Heights {
+  int samples = 0, in_band = 0, above_max = 0, below = 0, over_region = 0;
+};
+
+}  // namespace
+
+std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat& points,
+                                     const std::vector<int>& object_of_patch,
+                                     const std::vector<float>& cut_cost, const Camera& camera) {
+  if (object_labels.type() != CV_32S || points.type() != CV_32FC3 || object_labels.size() != points.size())
+    throw Error("describe_objects: labels must be CV_32S and points CV_32FC3 of the same size");
+  double max_id = 0;
+  cv::minMaxLoc(object_labels, nullptr, &max_id);
+  const int count = static_cast<int>(max_id);
+  std::vector<Object> objects(static_cast<size_t>(std::max(0, count)));
+  const Eigen::Matrix3d rot = camera.camera_to_robot.topLeftCorner<3, 3>();
+  const Eigen::Vector3d shift = camera.camera_to_robot.topRightCorner<3, 1>();
+  const int total = static_cast<int>(object_labels.total());
+  const int* lab = object_labels.ptr<int>();
+  const auto* pts = points.ptr<cv::Vec3f>();
+
+  std::vector<Eigen::Vector3d> sum(objects.size(), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Matrix3d> outer(objects.size(), Eigen::Matrix3d::Zero());
+  std::vector<int> valid(objects.size(), 0);
+  for (int i = 0; i < total; ++i) {
+    if (lab[i] <= 0) continue;
+    const size_t o = static_cast<size_t>(lab[i] - 1);
+    ++objects[o].pixel_count;
+    if (!valid_point(pts[i])) continue;
+    const Eigen::Vector3d q = rot * to_eigen(pts[i]) + shift;
+    sum[o] += q;
+    outer[o] += q * q.transpose();
+    ++valid[o];
+  }
+  std::vector<Eigen::Matrix3d> axes(objects.size(), Eigen::Matrix3d::Identity());
+  std::vector<Eigen::Vector3d> low(objects.size(), Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()));
+  std::vector<Eigen::Vector3d> high(objects.size(), -low[0]);
+  for (size_t o = 0; o < objects.size(); ++o) {
+    objects[o].id = static_cast<int>(o) + 1;
+    objects[o].cut_cost = o < cut_cost.size() ? cut_cost[o] : std::numeric_limits<float>::infinity();
+    if (valid[o] == 0) continue;
+    const Eigen::Vector3d mean = sum[o] / valid[o];
+    objects[o].centroid = mean.cast<float>();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer[o] / valid[o] - mean * mean.transpose());
+    axes[o] = eig.eigenvectors();
+  }
+  for (int i = 0; i < total; ++i) {
+    if (lab[i] <= 0 || !valid_point(pts[i])) continue;
+    const size_t o = static_cast<size_t>(lab[i] - 1);
+    const Eigen::Vector3d c = axes[o].transpose() * (rot * to_eigen(pts[i]) + shift);
+    low[o] = low[o].cwiseMin(c);
+    high[o] = high[o].cwiseMax(c);
+  }
+  for (size_t o = 0; o < objects.size(); ++o) {
+    if (valid[o] == 0) continue;
+    // Axes ordered by extent, largest first, and right-handed.
+    const Eigen::Vector3d extent = high[o] - low[o];
+    std::array<int, 3> order = {0, 1, 2};
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return extent(a) > extent(b); });
+    OrientedBox& box = objects[o].box;
+    for (int k = 0; k < 3; ++k) {
+      box.axes.col(k) = axes[o].col(order[static_cast<size_t>(k)]).cast<float>();
+      box.extents(k) = static_cast<float>(extent(order[static_cast<size_t>(k)]));
+    }
+    box.axes.col(2) = box.axes.col(0).cross(box.axes.col(1));
+    box.center = (axes[o] * (0.5 * (low[o] + high[o]))).cast<float>();
+  }
+  for (size_t p = 0; p < object_of_patch.size(); ++p) {
+    const int o = object_of_patch[p];
+    if (o >= 0 && o < count) objects[static_cast<size_t>(o)].patches.push_back(static_cast<int>(p));
+  }
+  return objects;
+}
+
+std::optional<Plane> find_support(std::vector<Object>& objects, const std::vector<Patch>& patches,
+                                  const cv::Mat& object_labels, const cv::Mat& points,
+                                  const Params::Support& params) {
+  if (object_labels.type() != CV_32S || points.type() != CV_32FC3 || object_labels.size() != points.size())
+    throw Error("find_support: labels must be CV_32S and points CV_32FC3 of the same size");
+  const int* lab = object_labels.ptr<int>();
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const int total = static_cast<int>(object_labels.total());
+  const int num_objects = static_cast<int>(objects.size());
+  auto object_of_pixel = [&](int i) { return lab[i] > 0 && lab[i] <= num_objects ? lab[i] - 1 : -1; };
+
+  // Pixels of every object, visited with a stride (bounded work per object and candidate).
+  std::vector<std::vector<int>> samples(objects.size());
+  {
+    std::vector<int> stride(objects.size());
+    for (size_t o = 0; o < objects.size(); ++o) stride[o] = std::max(1, objects[o].pixel_count / kSamplesPerObject);
+    std::vector<int> seen(objects.size(), 0);
+    for (int i = 0; i < total; ++i) {
+      const int o = object_of_pixel(i);
+      if (o < 0 || !valid_point(pts[i])) continue;
+      if (seen[static_cast<size_t>(o)]++ % stride[static_cast<size_t>(o)] == 0) samples[static_cast<size_t>(o)].push_back(i);
+    }
+  }
+  const int valid_total = cv::countNonZero(object_labels > 0);
+
+  // Candidates: large flat patches, largest first (at most 8 are scored).
+  std::vector<int> candidates;
+  for (size_t p = 0; p < patches.size(); ++p)
+    if (!patches[p].curved && static_cast<double>(patches[p].pixels.size()) >= 0.03 * valid_total) candidates.push_back(static_cast<int>(p));
+  std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
+    return patches[static_cast<size_t>(a)].pixels.size() > patches[static_cast<size_t>(b)].pixels.size();
+  });
+  if (candidates.size() > 8) candidates.resize(8);
+  if (candidates.empty()) return std::nullopt;
+  std::vector<int> object_of_candidate;
+  for (int c : candidates) {
+    const auto& px = patches[static_cast<size_t>(c)].pixels;
+    object_of_candidate.push_back(px.empty() ? -1 : object_of_pixel(px[px.size() / 2]));
+  }
+
+  // Score: object pixels resting over the candidate's visible region, between the plane band and
+  // max_height on its camera-facing side. Objects holding a candidate (other large planes) do not
+  // count, so a wall does not score the table in front of it.
+  auto heights = [&](int o, const PlaneRegion& region) {
+    Heights h;
+    for (int i : samples[static_cast<size_t>(o)]) {
+      const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
+      const float d = region.plane.distance(q);
+      ++h.samples;
+      h.in_band += std::abs(d) <= params.plane_band;
+      h.above_max += d > params.max_height;
+      h.below += d < -params.plane_band;
+      h.over_region += region.inside(q - d * region.plane.normal) >= -params.region_margin;
+    }
+    return h;
+  };
+  int best = -1;
+  double best_score = -1;
+  PlaneRegion best_region;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    Plane plane;
+    const auto& px = patches[static_cast<size_t>(candidates[k])].pixels;
+    if (!fit_plane(px, points, plane)) continue;
+    const PlaneRegion region = region_of(plane, px, points);
+    double score = 0;
+    for (int o = 0; o < num_objects; ++o) {
+      if (std::find(object_of_candidate.begin(), object_of_candidate.end(), o) != object_of_candidate.end()) continue;
+      int resting = 0;
+      for (int i : samples[static_cast<size_t>(o)]) {
+        const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
+        const float d = plane.distance(q);
+        if (d > params.plane_band && d <= params.max_height && region.inside(q - d * plane.normal) >= -params.region_margin) ++resting;
+      }
+      // Back to pixel units: samples are a stride of the object's pixels.
+      if (!samples[static_cast<size_t>(o)].empty())
+        score += static_cast<double>(resting) / samples[static_cast<size_t>(o)].size() * objects[static_cast<size_t>(o)].pixel_count;
+    }
+    if (score > best_score) { best_score = score; best = static_cast<int>(k); best_region = region; }
+  }
+  if (best < 0) return std::nullopt;
+  const Plane& plane = best_region.plane;
+  const Eigen::Vector3f up = plane.normal;
+
+  for (int o = 0; o < num_objects; ++o) {
+    Object& object = objects[static_cast<size_t>(o)];
+    if (o == object_of_candidate[static_cast<size_t>(best)]) { object.support = true; continue; }
+    const Heights h = heights(o, best_region);
+    if (h.samples == 0) continue;
+    const double n = h.samples;
+    // Other pieces of the table (split off by occluding objects) lie in its plane.
+    if (h.in_band >= 0.8 * n) { object.support = true; continue; }
+    if (h.above_max > 0.5 * n || h.below > 0.5 * n || h.over_region < 0.3 * n) { object.background = true; continue; }
+    // Walls: large and flat, standing roughly perpendicular to the table.
+    int largest = -1;
+    for (int p : object.patches)
+      if (largest < 0 || patches[static_cast<size_t>(p)].pixels.size() > patches[static_cast<size_t>(largest)].pixels.size()) largest = p;
+    if (largest >= 0 && !patches[static_cast<size_t>(largest)].curved &&
+        std::abs(patches[static_cast<size_t>(largest)].mean_normal.dot(up)) < std::cos(60.0 * M_PI / 180.0) &&
+        object.box.extents(0) >= params.wall_min_extent)
+      object.background = true;
+  }
+  return plane;
+}
 
 cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects) {
   // New ids keep the order of the old ones, so the view is as stable as the labels it comes from.

@@ -2,9 +2,18 @@
 
 #include <chrono>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "clutterseg/adjacency.hpp"
+#include "clutterseg/cutfree.hpp"
 #include "clutterseg/edges.hpp"
 #include "clutterseg/normals.hpp"
+#include "clutterseg/objects.hpp"
 #include "clutterseg/parallel.hpp"
+#include "clutterseg/remaining.hpp"
 
 namespace clutterseg {
 
@@ -26,6 +35,31 @@ class Stopwatch {
   Timings& out_;
   Clock::time_point start_, last_;
 };
+
+// Stand-in for f-i until the graph cut is merged: objects = connected components of the links (the
+// paper's "adjacency + cut-free only" comparison). Fills the weighted graph (1/deg, symmetrised).
+std::vector<int> linked_components(int num_patches, const std::vector<PatchPair>& links,
+                                   std::vector<GraphEdge>& graph, int& num_objects) {
+  std::vector<int> parent(static_cast<size_t>(num_patches));
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int x) { while (parent[static_cast<size_t>(x)] != x) x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])]; return x; };
+  std::vector<int> degree(static_cast<size_t>(num_patches), 0);
+  for (const auto& [a, b] : links) {
+    parent[static_cast<size_t>(root(a))] = root(b);
+    ++degree[static_cast<size_t>(a)];
+    ++degree[static_cast<size_t>(b)];
+  }
+  for (const auto& [a, b] : links)
+    graph.push_back({a, b, Cue::Adjacent, 0.5f / static_cast<float>(degree[static_cast<size_t>(a)]) + 0.5f / static_cast<float>(degree[static_cast<size_t>(b)])});
+  std::vector<int> object_of_root(static_cast<size_t>(num_patches), -1), object_of_patch(static_cast<size_t>(num_patches));
+  num_objects = 0;
+  for (int p = 0; p < num_patches; ++p) {
+    int& o = object_of_root[static_cast<size_t>(root(p))];
+    if (o < 0) o = num_objects++;
+    object_of_patch[static_cast<size_t>(p)] = o;
+  }
+  return object_of_patch;
+}
 
 cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
   if (depth.empty()) throw Error("depth image is empty");
@@ -66,9 +100,30 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   Patches patches = extract_patches(r.edges, r.points, r.normals, p.patches,     // c) surface patches
                                     scaled_min_patch_size(p.patches, width));
   r.core_patch_labels = patches.labels;
-  r.patch_labels = patches.labels;
   r.patches = std::move(patches.patches);
   watch.mark("patches");
+  const int num_patches = static_cast<int>(r.patches.size());
+  const int radius = static_cast<int>(std::lround(p.adjacency.radius_px * resolution_scale(width)));
+  Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches, radius,  // d) adjacency
+                                             p.adjacency.d_max);
+  r.patch_labels = assignment.labels;
+  watch.mark("assignment");
+  const std::vector<PatchPair> links = p.cutfree.enabled                                  // e) cut-free
+      ? cut_free_pairs(assignment.adjacent, r.patches, r.points, p.cutfree, p.seed) : assignment.adjacent;
+  watch.mark("cutfree");
+  int num_objects = 0;                                                                   // f-i) stand-in
+  const std::vector<int> object_of_patch = linked_components(num_patches, links, r.graph, num_objects);
+  std::vector<float> cut_cost(static_cast<size_t>(num_objects), std::numeric_limits<float>::infinity());
+  for (size_t q = 0; q < object_of_patch.size(); ++q)  // unknown until the graph cut: 0 for several patches
+    if (std::count(object_of_patch.begin(), object_of_patch.end(), object_of_patch[q]) > 1) cut_cost[static_cast<size_t>(object_of_patch[q])] = 0.f;
+  watch.mark("graph");
+  const double area_scale = resolution_scale(width) * resolution_scale(width);                  // j) remaining
+  r.object_labels = assign_remaining(r.patch_labels, object_of_patch, num_objects, r.points, p.remaining,
+                                     std::max(1, static_cast<int>(std::lround(p.remaining.tiny_px * area_scale))), p.seed);
+  watch.mark("remaining");
+  r.objects = describe_objects(r.object_labels, r.points, object_of_patch, cut_cost, camera);   // per object
+  r.support_plane = find_support(r.objects, r.patches, r.object_labels, r.points, p.support);   // table, walls
+  watch.mark("objects");
   watch.total();
   return r;
 }
