@@ -34,8 +34,7 @@ cv::Mat normal_edge_value(const cv::Mat& normals, int step) {
   return value;
 }
 
-cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& points, double theta, int step,
-                  float jump_limit) {
+cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& points, double theta, float jump_limit) {
   const int rows = points.rows, cols = points.cols;
   cv::Mat edges(points.size(), CV_8U);
   const float th = static_cast<float>(theta);
@@ -48,7 +47,7 @@ cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& points, double theta
         const float z = p[x][2];
         bool edge = z <= 0 || v[x] < th;
         for (int k = 0; k < 8 && !edge; ++k) {
-          const int xx = x + kDirs[k][0] * step, yy = y + kDirs[k][1] * step;
+          const int xx = x + kDirs[k][0], yy = y + kDirs[k][1];
           if (xx < 0 || yy < 0 || xx >= cols || yy >= rows) continue;
           const float zq = points.at<cv::Vec3f>(yy, xx)[2];
           edge = zq > 0 && std::abs(zq - z) > jump_limit * z;

@@ -28,19 +28,6 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
   return static_cast<float>(params.jump_slope * step / std::min(camera.fx, camera.fy));
 }
 
-int scaled_normal_step(const Params::Normals& params, int width) {
-  return std::max(1, static_cast<int>(std::lround(params.step_px * resolution_scale(width))));
-}
-
-int scaled_edge_step(const Params::Edges& params, int width) {
-  return std::max(1, static_cast<int>(std::lround(params.step_px * resolution_scale(width))));
-}
-
-int scaled_smooth_ksize(const Params::Normals& params, int width) {
-  const int half = static_cast<int>(std::lround((params.smooth_ksize - 1) / 2.0 * resolution_scale(width)));
-  return 2 * std::max(0, half) + 1;
-}
-
 namespace {
 
 // Difference across p along one axis: central if both neighbours continue the surface, else one-sided.

@@ -5,11 +5,6 @@
 
 namespace clutterseg {
 
-int scaled_min_patch_size(const Params::Patches& params, int width) {
-  const double s = resolution_scale(width);
-  return std::max(1, static_cast<int>(std::lround(params.min_size_px * s * s)));
-}
-
 std::vector<float> normal_histogram(const cv::Mat& normals, const std::vector<int>& pixels, int bins) {
   std::vector<float> hist(static_cast<size_t>(bins * bins), 0.f);
   if (pixels.empty()) return hist;

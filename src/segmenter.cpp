@@ -76,11 +76,10 @@ Segmenter::Segmenter(Params params) : params_(std::move(params)) {}
 Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   const Params& p = params_;
   set_threads(p.threads);
-  const int width = depth_in.cols;
-  const int step = scaled_normal_step(p.normals, width);
+  const PixelScale px(camera.fx, camera.fy);
+  const int step = px.length(p.normals.step_px), edge_step = px.length(p.edges.step_px);
   const float jump = relative_jump_limit(p.edges, step, camera);
-  const int edge_step = scaled_edge_step(p.edges, width);
-  const float edge_jump = relative_jump_limit(p.edges, edge_step, camera);
+  const float pixel_jump = relative_jump_limit(p.edges, 1, camera);
   cv::Mat depth = checked_metres(depth_in, camera);
 
   Result r;
@@ -92,13 +91,13 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   r.depth = depth;
   r.points = depth_to_points(depth, camera);                                     // point cloud
   watch.mark("pointcloud");
-  r.normals = compute_normals(r.points, step, scaled_smooth_ksize(p.normals, width), jump);  // a) normals
+  r.normals = compute_normals(r.points, step, px.odd(p.normals.smooth_ksize), jump);  // a) normals
   watch.mark("normals");
   r.edge_value = normal_edge_value(r.normals, edge_step);                        // b) normal edges
-  r.edges = edge_mask(r.edge_value, r.points, p.edges.theta, edge_step, edge_jump);
+  r.edges = edge_mask(r.edge_value, r.points, p.edges.theta, pixel_jump);
   watch.mark("edges");
   Patches patches = extract_patches(r.edges, r.points, r.normals, p.patches,     // c) surface patches
-                                    scaled_min_patch_size(p.patches, width));
+                                    px.area(p.patches.min_size_px));
   r.core_patch_labels = patches.labels;
   r.patches = std::move(patches.patches);
   watch.mark("patches");

@@ -71,7 +71,7 @@ TEST(Edges, PlaneHasNoEdgesAndAStepHasOne) {
   auto edges_of = [&](const cv::Mat& depth) {
     const cv::Mat pts = depth_to_points(depth, cam);
     const float jump = relative_jump_limit(pe, 1, cam);
-    return edge_mask(normal_edge_value(compute_normals(pts, 1, 5, jump), 1), pts, pe.theta, 1, jump);
+    return edge_mask(normal_edge_value(compute_normals(pts, 1, 5, jump), 1), pts, pe.theta, jump);
   };
   EXPECT_EQ(cv::countNonZero(edges_of(d)), 0);
   d(cv::Rect(32, 0, 32, 48)).setTo(0.8f);  // a 20 cm step

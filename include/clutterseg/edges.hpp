@@ -11,8 +11,8 @@ namespace clutterseg {
 cv::Mat normal_edge_value(const cv::Mat& normals, int step);
 
 // Binary edge image (CV_8U, 255 = edge): edge value below theta, no measurement, or a depth jump
-// (relative to z, see relative_jump_limit) to any of the 8 neighbours at distance `step`.
-cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& points, double theta, int step,
-                  float jump_limit);
+// to any of the 8 immediate neighbours larger than jump_limit * z (relative_jump_limit for step 1):
+// discontinuities are tested between adjacent pixels, where the median keeps them sharp.
+cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& points, double theta, float jump_limit);
 
 }  // namespace clutterseg

@@ -18,9 +18,5 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
 // back to the one-sided difference. step and ksize are the resolution-scaled values.
 cv::Mat compute_normals(const cv::Mat& points, int step, int ksize, float jump_limit);
 
-// Resolution-scaled kernel sizes for an image of the given width.
-int scaled_normal_step(const Params::Normals& params, int width);
-int scaled_edge_step(const Params::Edges& params, int width);
-int scaled_smooth_ksize(const Params::Normals& params, int width);
 
 }  // namespace clutterseg

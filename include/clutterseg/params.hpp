@@ -1,8 +1,10 @@
 // All tunable values of clutterseg, one struct per stage of the paper (Ückermann et al., IROS 2013,
 // Sec. II). Every default is in physical or scale-free units so that it works on any depth sensor and
-// resolution; pixel sizes are given for 320x240 (the paper's resolution) and scaled with the image width.
+// resolution; pixel sizes are for the paper's 320x240 Kinect v1 and scaled by PixelScale (bottom of file).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -20,21 +22,21 @@ struct Params {
 
   // a) Normals by cross product of image neighbours on the organized 3D points, then Gaussian-smoothed.
   struct Normals {
-    int step_px = 1;             // neighbour distance at 320x240 [px]; scaled with resolution
-    int smooth_ksize = 5;        // Gaussian kernel at 320x240 [px, odd]; scaled with resolution
+    int step_px = 1;             // neighbour distance at 320x240 [px], scaled (PixelScale)
+    int smooth_ksize = 5;        // Gaussian kernel at 320x240 [px, odd], scaled (PixelScale)
   } normals;
 
   // b) Normal edges.
   struct Edges {
-    double theta = 0.85;         // pixel is an edge when mean_q |n(p).n(q)| over 8 neighbours < theta
-    int step_px = 2;             // distance of the 8 neighbours at 320x240 [px]; scaled with resolution
+    double theta = 0.89;         // pixel is an edge when mean_q |n(p).n(q)| over 8 neighbours < theta
+    int step_px = 2;             // distance of the 8 neighbours at 320x240 [px], scaled (PixelScale)
     double jump_slope = 10;      // depth discontinuity: |z(p) - z(q)| > jump_slope * lateral distance
                                  // of the two pixels (a surface steeper than ~84 deg to the view ray)
   } edges;
 
   // c) Surface patches = 4-connected components of non-edge pixels.
   struct Patches {
-    int min_size_px = 50;        // smallest patch at 320x240 [px]; scaled with image area
+    int min_size_px = 50;        // smallest patch at 320x240 [px], scaled (PixelScale)
     int histogram_bins = 11;     // normal (x, y) histogram bins per axis
     double occupied_share = 0.005;  // a histogram bin counts as occupied above this share [-]
     int flat_max_bins = 8;       // a patch is flat when fewer bins than this are occupied
@@ -42,7 +44,7 @@ struct Params {
 
   // d) Adjacency and assignment of edge pixels to the nearest patch.
   struct Adjacency {
-    double radius_px = 7;        // image search radius at 320x240 [px]; scaled with resolution
+    double radius_px = 7;        // image search radius at 320x240 [px], scaled (PixelScale)
     double d_max = 0.015;        // largest 3D distance to a patch pixel [m]
   } adjacency;
 
@@ -86,7 +88,7 @@ struct Params {
   // j) Remaining (unassigned) pixels.
   struct Remaining {
     double grow_distance = 0.01; // 8-connected Euclidean region growing [m]
-    int tiny_px = 20;            // "very few points" at 320x240 [px]; scaled with image area
+    int tiny_px = 20;            // "very few points" at 320x240 [px], scaled (PixelScale)
   } remaining;
 
   // Support plane (table) detection for the objects-only view.
@@ -104,7 +106,15 @@ struct Params {
   int threads = 0;               // 0 = all cores (OpenMP); results do not depend on it
 };
 
-// Resolution scale factor relative to the paper's 320x240.
-inline double resolution_scale(int width) { return width / 320.0; }
+// Pixel sizes in Params are for the paper's camera: a 320x240 Kinect v1, fx = fy = 262.5 px. They are
+// scaled by the angular resolution sqrt(fx * fy) / 262.5, so that a window covers the same field of
+// view on any sensor and resolution (x2 for a 640x480 Kinect, x4 for YCB-Video's Xtion at fx = 1067).
+struct PixelScale {
+  double factor = 1;
+  PixelScale(double fx, double fy) : factor(std::sqrt(fx * fy) / 262.5) {}
+  int length(double px) const { return std::max(1, static_cast<int>(std::lround(px * factor))); }
+  int area(double px) const { return std::max(1, static_cast<int>(std::lround(px * factor * factor))); }
+  int odd(int ksize) const { return 2 * static_cast<int>(std::lround((ksize - 1) / 2.0 * factor)) + 1; }
+};
 
 }  // namespace clutterseg

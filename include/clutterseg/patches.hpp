@@ -19,6 +19,5 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
 // Normal (x, y) histogram of the given pixels: bins x bins shares summing to 1.
 std::vector<float> normal_histogram(const cv::Mat& normals, const std::vector<int>& pixels, int bins);
 
-int scaled_min_patch_size(const Params::Patches& params, int width);
 
 }  // namespace clutterseg
