@@ -40,19 +40,22 @@ bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& pla
   return true;
 }
 
-// The visible region of a support candidate: convex hull of its points projected into the plane.
+// The visible region of a support candidate: convex hull of its points projected into the plane,
+// grown by a margin and rasterised at 1 cm so that the test per point is a lookup.
 struct PlaneRegion {
   Plane plane;
-  Eigen::Vector3f u, v;          // orthonormal basis of the plane
-  std::vector<cv::Point2f> hull;  // in millimetres
-  cv::Point2f project(const Eigen::Vector3f& q) const { return {1000.f * u.dot(q), 1000.f * v.dot(q)}; }
-  // Signed distance to the hull in metres (> 0 inside).
-  double inside(const Eigen::Vector3f& q) const {
-    return hull.size() < 3 ? -1e9 : cv::pointPolygonTest(hull, project(q), true) / 1000.0;
+  Eigen::Vector3f u, v;   // orthonormal basis of the plane
+  cv::Point2f origin;     // plane coordinates [m] of cell (0, 0)
+  cv::Mat cells;          // CV_8U, 255 = over the region
+  static constexpr float kCell = 0.01f;  // [m]
+  bool over(const Eigen::Vector3f& q) const {
+    const int cx = static_cast<int>(std::floor((u.dot(q) - origin.x) / kCell));
+    const int cy = static_cast<int>(std::floor((v.dot(q) - origin.y) / kCell));
+    return cx >= 0 && cy >= 0 && cx < cells.cols && cy < cells.rows && cells.at<uchar>(cy, cx);
   }
 };
 
-PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points) {
+PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin) {
   PlaneRegion r;
   r.plane = plane;
   r.u = plane.normal.unitOrthogonal();
@@ -61,9 +64,48 @@ PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const 
   std::vector<cv::Point2f> projected;
   const size_t stride = std::max<size_t>(1, pixels.size() / 4000);
   for (size_t k = 0; k < pixels.size(); k += stride)
-    if (valid_point(pts[pixels[k]])) projected.push_back(r.project(to_eigen(pts[pixels[k]]).cast<float>()));
-  if (projected.size() >= 3) cv::convexHull(projected, r.hull);
+    if (valid_point(pts[pixels[k]])) {
+      const Eigen::Vector3f q = to_eigen(pts[pixels[k]]).cast<float>();
+      projected.emplace_back(r.u.dot(q), r.v.dot(q));
+    }
+  if (projected.size() < 3) return r;
+  std::vector<cv::Point2f> hull;
+  cv::convexHull(projected, hull);
+  cv::Rect2f box(hull[0], hull[0]);
+  for (const auto& h : hull) {
+    const float x1 = std::max(box.x + box.width, h.x), y1 = std::max(box.y + box.height, h.y);
+    box.x = std::min(box.x, h.x);
+    box.y = std::min(box.y, h.y);
+    box.width = x1 - box.x;
+    box.height = y1 - box.y;
+  }
+  const int pad = static_cast<int>(std::ceil(margin / PlaneRegion::kCell)) + 1;
+  r.origin = {box.x - pad * PlaneRegion::kCell, box.y - pad * PlaneRegion::kCell};
+  // Bounded: a region larger than 20 m x 20 m is cut (no depth sensor sees one).
+  const int cols = std::min(2000, static_cast<int>(std::ceil(box.width / PlaneRegion::kCell)) + 2 * pad + 1);
+  const int rows = std::min(2000, static_cast<int>(std::ceil(box.height / PlaneRegion::kCell)) + 2 * pad + 1);
+  r.cells = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  std::vector<cv::Point> poly;
+  for (const auto& h : hull)
+    poly.emplace_back(static_cast<int>(std::lround((h.x - r.origin.x) / PlaneRegion::kCell)),
+                      static_cast<int>(std::lround((h.y - r.origin.y) / PlaneRegion::kCell)));
+  cv::fillConvexPoly(r.cells, poly, cv::Scalar(255));
+  if (pad > 1) cv::dilate(r.cells, r.cells, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * pad - 1, 2 * pad - 1}));
   return r;
+}
+
+// Share of a patch's points within `band` of its least-squares plane (flatness that does not depend
+// on the normal histogram, which noise spreads on large, far surfaces).
+double inlier_share(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double band) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
+  int in = 0, n = 0;
+  for (size_t k = 0; k < pixels.size(); k += stride) {
+    if (!valid_point(pts[pixels[k]])) continue;
+    ++n;
+    in += std::abs(plane.distance(to_eigen(pts[pixels[k]]).cast<float>())) <= band;
+  }
+  return n ? static_cast<double>(in) / n : 0.0;
 }
 
 // Pixels visited per object when classifying it against the table (a share is all we need).
@@ -170,8 +212,14 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
 
   // Candidates: large flat patches, largest first (at most 8 are scored).
   std::vector<int> candidates;
-  for (size_t p = 0; p < patches.size(); ++p)
-    if (!patches[p].curved && static_cast<double>(patches[p].pixels.size()) >= 0.03 * valid_total) candidates.push_back(static_cast<int>(p));
+  std::vector<Plane> planes(patches.size());
+  std::vector<bool> flat(patches.size(), false);
+  for (size_t p = 0; p < patches.size(); ++p) {
+    if (static_cast<double>(patches[p].pixels.size()) < 0.02 * valid_total) continue;
+    flat[p] = fit_plane(patches[p].pixels, points, planes[p]) &&
+              inlier_share(patches[p].pixels, points, planes[p], params.plane_band) >= 0.9;
+    if (flat[p]) candidates.push_back(static_cast<int>(p));
+  }
   std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
     return patches[static_cast<size_t>(a)].pixels.size() > patches[static_cast<size_t>(b)].pixels.size();
   });
@@ -195,7 +243,7 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
       h.in_band += std::abs(d) <= params.plane_band;
       h.above_max += d > params.max_height;
       h.below += d < -params.plane_band;
-      h.over_region += region.inside(q - d * region.plane.normal) >= -params.region_margin;
+      h.over_region += region.over(q);
     }
     return h;
   };
@@ -203,10 +251,9 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
   double best_score = -1;
   PlaneRegion best_region;
   for (size_t k = 0; k < candidates.size(); ++k) {
-    Plane plane;
+    const Plane& plane = planes[static_cast<size_t>(candidates[k])];
     const auto& px = patches[static_cast<size_t>(candidates[k])].pixels;
-    if (!fit_plane(px, points, plane)) continue;
-    const PlaneRegion region = region_of(plane, px, points);
+    const PlaneRegion region = region_of(plane, px, points, params.region_margin);
     double score = 0;
     for (int o = 0; o < num_objects; ++o) {
       if (std::find(object_of_candidate.begin(), object_of_candidate.end(), o) != object_of_candidate.end()) continue;
@@ -214,7 +261,7 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
       for (int i : samples[static_cast<size_t>(o)]) {
         const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
         const float d = plane.distance(q);
-        if (d > params.plane_band && d <= params.max_height && region.inside(q - d * plane.normal) >= -params.region_margin) ++resting;
+        if (d > params.plane_band && d <= params.max_height && region.over(q)) ++resting;
       }
       // Back to pixel units: samples are a stride of the object's pixels.
       if (!samples[static_cast<size_t>(o)].empty())
@@ -239,8 +286,10 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
     int largest = -1;
     for (int p : object.patches)
       if (largest < 0 || patches[static_cast<size_t>(p)].pixels.size() > patches[static_cast<size_t>(largest)].pixels.size()) largest = p;
-    if (largest >= 0 && !patches[static_cast<size_t>(largest)].curved &&
-        std::abs(patches[static_cast<size_t>(largest)].mean_normal.dot(up)) < std::cos(60.0 * M_PI / 180.0) &&
+    Plane own;
+    if (largest >= 0 && fit_plane(patches[static_cast<size_t>(largest)].pixels, points, own) &&
+        inlier_share(patches[static_cast<size_t>(largest)].pixels, points, own, params.plane_band) >= 0.9 &&
+        std::abs(own.normal.dot(up)) < std::cos(60.0 * M_PI / 180.0) &&
         object.box.extents(0) >= params.wall_min_extent)
       object.background = true;
   }

@@ -38,8 +38,11 @@ class Stopwatch {
 
 // Stand-in for f-i until the graph cut is merged: objects = connected components of the links (the
 // paper's "adjacency + cut-free only" comparison). Fills the weighted graph (1/deg, symmetrised).
-std::vector<int> linked_components(int num_patches, const std::vector<PatchPair>& links,
-                                   std::vector<GraphEdge>& graph, int& num_objects) {
+struct Components {
+  std::vector<int> object_of_patch;
+  std::vector<float> cut_cost;  // +inf for one patch; 0 (unknown) for several until the graph cut
+};
+Components linked_components(int num_patches, const std::vector<PatchPair>& links, std::vector<GraphEdge>& graph) {
   std::vector<int> parent(static_cast<size_t>(num_patches));
   std::iota(parent.begin(), parent.end(), 0);
   auto root = [&](int x) { while (parent[static_cast<size_t>(x)] != x) x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])]; return x; };
@@ -51,14 +54,19 @@ std::vector<int> linked_components(int num_patches, const std::vector<PatchPair>
   }
   for (const auto& [a, b] : links)
     graph.push_back({a, b, Cue::Adjacent, 0.5f / static_cast<float>(degree[static_cast<size_t>(a)]) + 0.5f / static_cast<float>(degree[static_cast<size_t>(b)])});
-  std::vector<int> object_of_root(static_cast<size_t>(num_patches), -1), object_of_patch(static_cast<size_t>(num_patches));
-  num_objects = 0;
+  std::vector<int> object_of_root(static_cast<size_t>(num_patches), -1);
+  Components c;
   for (int p = 0; p < num_patches; ++p) {
     int& o = object_of_root[static_cast<size_t>(root(p))];
-    if (o < 0) o = num_objects++;
-    object_of_patch[static_cast<size_t>(p)] = o;
+    if (o < 0) {
+      o = static_cast<int>(c.cut_cost.size());
+      c.cut_cost.push_back(std::numeric_limits<float>::infinity());
+    } else {
+      c.cut_cost[static_cast<size_t>(o)] = 0.f;
+    }
+    c.object_of_patch.push_back(o);
   }
-  return object_of_patch;
+  return c;
 }
 
 cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
@@ -102,25 +110,20 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   r.patches = std::move(patches.patches);
   watch.mark("patches");
   const int num_patches = static_cast<int>(r.patches.size());
-  const int radius = static_cast<int>(std::lround(p.adjacency.radius_px * resolution_scale(width)));
-  Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches, radius,  // d) adjacency
-                                             p.adjacency.d_max);
+  const Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency
+                                                   px.length(p.adjacency.radius_px), p.adjacency.d_max);
   r.patch_labels = assignment.labels;
   watch.mark("assignment");
   const std::vector<PatchPair> links = p.cutfree.enabled                                  // e) cut-free
       ? cut_free_pairs(assignment.adjacent, r.patches, r.points, p.cutfree, p.seed) : assignment.adjacent;
   watch.mark("cutfree");
-  int num_objects = 0;                                                                   // f-i) stand-in
-  const std::vector<int> object_of_patch = linked_components(num_patches, links, r.graph, num_objects);
-  std::vector<float> cut_cost(static_cast<size_t>(num_objects), std::numeric_limits<float>::infinity());
-  for (size_t q = 0; q < object_of_patch.size(); ++q)  // unknown until the graph cut: 0 for several patches
-    if (std::count(object_of_patch.begin(), object_of_patch.end(), object_of_patch[q]) > 1) cut_cost[static_cast<size_t>(object_of_patch[q])] = 0.f;
+  const Components parts = linked_components(num_patches, links, r.graph);               // f-i) stand-in
   watch.mark("graph");
-  const double area_scale = resolution_scale(width) * resolution_scale(width);                  // j) remaining
-  r.object_labels = assign_remaining(r.patch_labels, object_of_patch, num_objects, r.points, p.remaining,
-                                     std::max(1, static_cast<int>(std::lround(p.remaining.tiny_px * area_scale))), p.seed);
+  r.object_labels = assign_remaining(r.patch_labels, parts.object_of_patch,                      // j) remaining
+                                     static_cast<int>(parts.cut_cost.size()), r.points, p.remaining,
+                                     px.area(p.remaining.tiny_px), p.seed);
   watch.mark("remaining");
-  r.objects = describe_objects(r.object_labels, r.points, object_of_patch, cut_cost, camera);   // per object
+  r.objects = describe_objects(r.object_labels, r.points, parts.object_of_patch, parts.cut_cost, camera);  // objects
   r.support_plane = find_support(r.objects, r.patches, r.object_labels, r.points, p.support);   // table, walls
   watch.mark("objects");
   watch.total();
