@@ -231,8 +231,8 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
     object_of_candidate.push_back(px.empty() ? -1 : object_of_pixel(px[px.size() / 2]));
   }
 
-  // Score: object pixels resting over the candidate's visible region, between the plane band and
-  // max_height on its camera-facing side. Objects holding a candidate (other large planes) do not
+  // Score: pixels of objects resting on the candidate (touching it, over its visible region), between
+  // the plane band and max_height on its camera-facing side. Objects holding a candidate (other large planes) do not
   // count, so a wall does not score the table in front of it.
   auto heights = [&](int o, const PlaneRegion& region) {
     Heights h;
@@ -257,12 +257,18 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
     double score = 0;
     for (int o = 0; o < num_objects; ++o) {
       if (std::find(object_of_candidate.begin(), object_of_candidate.end(), o) != object_of_candidate.end()) continue;
+      // An object rests on the plane when its lowest point over the region is within contact_distance
+      // (a box in front of a wall floats 20 cm off it).
       int resting = 0;
+      float lowest = std::numeric_limits<float>::infinity();
       for (int i : samples[static_cast<size_t>(o)]) {
         const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
         const float d = plane.distance(q);
-        if (d > params.plane_band && d <= params.max_height && region.over(q)) ++resting;
+        if (d <= -params.plane_band || d > params.max_height || !region.over(q)) continue;
+        lowest = std::min(lowest, d);
+        resting += d > params.plane_band;
       }
+      if (lowest > params.contact_distance) continue;
       // Back to pixel units: samples are a stride of the object's pixels.
       if (!samples[static_cast<size_t>(o)].empty())
         score += static_cast<double>(resting) / samples[static_cast<size_t>(o)].size() * objects[static_cast<size_t>(o)].pixel_count;

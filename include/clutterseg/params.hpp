@@ -96,6 +96,7 @@ struct Params {
     bool objects_only = false;   // label 0 for the support plane and background surfaces
     double plane_band = 0.015;   // pixels within this of the table plane belong to it [m]
     double max_height = 0.5;     // objects higher above the table than this are background [m]
+    double contact_distance = 0.05;  // an object rests on a plane when its lowest point is this close [m]
     double region_margin = 0.05; // an object stands on the table when it projects within this of the
                                  // table's visible region (convex hull in the plane) [m]
     double wall_min_extent = 0.5;  // a flat object at least this large, roughly perpendicular to the
