@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
@@ -106,6 +107,47 @@ double inlier_share(const std::vector<int>& pixels, const cv::Mat& points, const
     in += std::abs(plane.distance(to_eigen(pts[pixels[k]]).cast<float>())) <= band;
   }
   return n ? static_cast<double>(in) / n : 0.0;
+}
+
+// Dominant plane of a patch: RANSAC over its points (a table patch may hold the foot of an object that
+// the edges did not separate), refined by least squares on the inliers. Deterministic: the draws are
+// seeded by the patch size. Returns the inlier share.
+double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, double band, Plane& plane) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  std::vector<int> sample;
+  const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
+  for (size_t k = 0; k < pixels.size(); k += stride)
+    if (valid_point(pts[pixels[k]])) sample.push_back(pixels[k]);
+  if (sample.size() < 10) return 0;
+  std::uint64_t state = 0x9e3779b97f4a7c15ULL ^ pixels.size();
+  auto next = [&] {  // xorshift64: a small, portable, seeded generator
+    state ^= state << 13; state ^= state >> 7; state ^= state << 17;
+    return static_cast<size_t>(state % sample.size());
+  };
+  int best_count = -1;
+  Plane best;
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    const Eigen::Vector3f a = to_eigen(pts[sample[next()]]).cast<float>();
+    const Eigen::Vector3f b = to_eigen(pts[sample[next()]]).cast<float>();
+    const Eigen::Vector3f c = to_eigen(pts[sample[next()]]).cast<float>();
+    Eigen::Vector3f n = (b - a).cross(c - a);
+    if (n.norm() < 1e-9f) continue;
+    n.normalize();
+    if (n.dot(a) > 0) n = -n;
+    Plane candidate{n, -n.dot(a)};
+    int count = 0;
+    for (int i : sample) count += std::abs(candidate.distance(to_eigen(pts[i]).cast<float>())) <= band;
+    if (count > best_count) { best_count = count; best = candidate; }
+  }
+  if (best_count <= 0) return 0;
+  std::vector<int> inliers;
+  for (int i : sample)
+    if (std::abs(best.distance(to_eigen(pts[i]).cast<float>())) <= band) inliers.push_back(i);
+  plane = best;
+  if (fit_plane(inliers, points, plane) && inlier_share(sample, points, plane, band) >= static_cast<double>(best_count) / sample.size())
+    return inlier_share(sample, points, plane, band);
+  plane = best;
+  return static_cast<double>(best_count) / sample.size();
 }
 
 // Pixels visited per object when classifying it against the table (a share is all we need).
@@ -216,8 +258,7 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
   std::vector<bool> flat(patches.size(), false);
   for (size_t p = 0; p < patches.size(); ++p) {
     if (static_cast<double>(patches[p].pixels.size()) < 0.02 * valid_total) continue;
-    flat[p] = fit_plane(patches[p].pixels, points, planes[p]) &&
-              inlier_share(patches[p].pixels, points, planes[p], params.plane_band) >= 0.9;
+    flat[p] = dominant_plane(patches[p].pixels, points, params.plane_band, planes[p]) >= 0.6;
     if (flat[p]) candidates.push_back(static_cast<int>(p));
   }
   std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
@@ -225,6 +266,9 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
   });
   if (candidates.size() > 8) candidates.resize(8);
   if (candidates.empty()) return std::nullopt;
+  std::vector<int> candidate_of_pixel(static_cast<size_t>(total), -1);
+  for (size_t k = 0; k < candidates.size(); ++k)
+    for (int i : patches[static_cast<size_t>(candidates[k])].pixels) candidate_of_pixel[static_cast<size_t>(i)] = static_cast<int>(k);
   std::vector<int> object_of_candidate;
   for (int c : candidates) {
     const auto& px = patches[static_cast<size_t>(c)].pixels;
@@ -256,12 +300,17 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
     const PlaneRegion region = region_of(plane, px, points, params.region_margin);
     double score = 0;
     for (int o = 0; o < num_objects; ++o) {
-      if (std::find(object_of_candidate.begin(), object_of_candidate.end(), o) != object_of_candidate.end()) continue;
+      // Other large planes (walls, other tables) are not mass on this one; the candidate's own object
+      // counts (objects the edges did not separate from the table stand on it).
+      if (o != object_of_candidate[k] &&
+          std::find(object_of_candidate.begin(), object_of_candidate.end(), o) != object_of_candidate.end()) continue;
       // An object rests on the plane when its lowest point over the region is within contact_distance
       // (a box in front of a wall floats 20 cm off it).
       int resting = 0;
       float lowest = std::numeric_limits<float>::infinity();
       for (int i : samples[static_cast<size_t>(o)]) {
+        const int on_candidate = candidate_of_pixel[static_cast<size_t>(i)];
+        if (on_candidate >= 0 && on_candidate != static_cast<int>(k)) continue;  // another large plane
         const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
         const float d = plane.distance(q);
         if (d <= -params.plane_band || d > params.max_height || !region.over(q)) continue;

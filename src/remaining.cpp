@@ -1,6 +1,6 @@
 // Paper j): remaining points. Pixels no patch took are grown into segments (8-connected, Euclidean
 // distance between image neighbours), then each segment follows the paper's five rules:
-//   1. no neighbouring face (missing depth around it)       -> a new object
+//   1. no neighbouring face (missing depth around it)       -> a new object (none if tiny: noise)
 //   2. one neighbouring face and tiny                       -> joins that face's object
 //   3. one face: enclosed by it -> a new object, else joins it
 //   4. several faces, all of one object                     -> joins that object
@@ -166,7 +166,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
 
     if (faces.empty()) {                                              // rule 1
-      set_all(++next_object);
+      // A tiny segment alone is sensor noise (stereo sensors leave thousands of them), not an object.
+      if (static_cast<int>(seg.pixels.size()) >= tiny_px) set_all(++next_object);
       continue;
     }
     if (faces.size() == 1) {

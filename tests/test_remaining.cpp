@@ -45,6 +45,8 @@ TEST(Remaining, Rule1NoNeighbourBecomesANewObject) {
   const cv::Mat o = c.run({0}, 1);
   EXPECT_EQ(o.at<int>(12, 27), 2);
   EXPECT_EQ(o.at<int>(5, 35), 0);  // no depth: nothing
+  // The same blob below tiny_px is noise: no object.
+  EXPECT_EQ(c.run({0}, 1, 40).at<int>(12, 27), 0);
   // Pixels next to the patch (columns 10-11) have it as their only neighbour and are not enclosed.
   EXPECT_EQ(o.at<int>(5, 11), 1);
 }
