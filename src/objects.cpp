@@ -325,6 +325,15 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
     if (score > best_score) { best_score = score; best = static_cast<int>(k); best_region = region; }
   }
   if (best < 0) return std::nullopt;
+  // The table's visible region: every patch lying in its plane (objects split the table into pieces;
+  // objects at the back stand on pieces other than the largest).
+  {
+    std::vector<int> table_pixels;
+    for (const auto& patch : patches)
+      if (inlier_share(patch.pixels, points, best_region.plane, params.plane_band) >= 0.8)
+        table_pixels.insert(table_pixels.end(), patch.pixels.begin(), patch.pixels.end());
+    best_region = region_of(best_region.plane, table_pixels, points, params.region_margin);
+  }
   const Plane& plane = best_region.plane;
   const Eigen::Vector3f up = plane.normal;
 
