@@ -43,7 +43,12 @@ bool one_side_of(const Patch& cutter, const Patch& other, const cv::Mat& points,
   std::mt19937_64 rng(mix(seed));
   std::uniform_int_distribution<size_t> pick(0, cutter.pixels.size() - 1);
   const float band = static_cast<float>(params.band);
-  const double allowed = params.wrong_side_fraction * static_cast<double>(samples.size());
+  // Tolerance relative to the smaller patch: a box at the back of a table leaves only a few percent
+  // of the table behind its front plane, yet thousands of points, many more than noise at a shared
+  // edge. (In sample units: the samples stand for all of other's points.)
+  const double smaller = static_cast<double>(std::min(cutter.pixels.size(), other.pixels.size()));
+  const double allowed = params.wrong_side_fraction * smaller * static_cast<double>(samples.size()) /
+                         static_cast<double>(other.pixels.size());
   int planes = 0, accepted = 0;
   // Nearly collinear triples give no plane; they are drawn again, a bounded number of times.
   for (int attempt = 0; attempt < 4 * params.planes && planes < params.planes; ++attempt) {

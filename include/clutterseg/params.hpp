@@ -53,7 +53,8 @@ struct Params {
     bool enabled = true;
     int planes = 20;             // RANSAC planes per patch and direction
     double band = 0.008;         // points within +-band of a plane count as on it [m]
-    double wrong_side_fraction = 0.1;  // a plane cuts when more than this share lies on its minority side
+    double wrong_side_fraction = 0.1;  // a plane cuts when its minority side holds more points than this
+                                       // share of the smaller patch [-]
     double skip_angle_deg = 30;  // pairs with mean normals closer than this skip the test (the authors' choice)
     bool skip_similar = true;    // set false to always test
   } cutfree;
