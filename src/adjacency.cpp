@@ -33,8 +33,9 @@ float squared_distance(const cv::Vec3f& a, const cv::Vec3f& b) {
 constexpr int kMaxSeeds = 4;
 
 struct Seed {
-  int label;   // patch id 1..N
-  int pixel;   // linear index of the patch pixel
+  cv::Vec3f point;    // the patch pixel's 3D point (carried along: no random reads of the cloud)
+  int label;          // patch id 1..N
+  int pixel;          // linear index of the patch pixel
   std::int16_t x, y;  // its image position (no division in the inner loop)
   float d2;    // squared 3D distance to the pixel holding it; for a pixel without depth, the squared
                // image distance instead (it only relays, keeping the seeds nearest in the image)
@@ -87,6 +88,8 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     }
     return false;
   };
+  std::vector<std::uint8_t> patch_pixel(static_cast<size_t>(total), 0);  // a patch pixel with depth
+  for (int i = 0; i < total; ++i) patch_pixel[static_cast<size_t>(i)] = lab[i] > 0 && lab[i] <= num_patches && valid_point(pts[i]);
   std::vector<int> slot(static_cast<size_t>(total), -1);  // index into seeds, -1 = patch or no carrier
   std::vector<int> carriers;
   for (int y = 0; y < height; ++y)
@@ -105,23 +108,27 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     const int x = i % width, y = i / width;
     const bool has_point = valid_point(pts[i]);
     SeedSet& own = seeds[static_cast<size_t>(slot[static_cast<size_t>(i)])];
-    auto offer = [&](int label, int pixel, int sx, int sy) {
+    const cv::Vec3f here = pts[i];
+    auto offer = [&](const cv::Vec3f& point, int label, int pixel, int sx, int sy) {
       const int dx = sx - x, dy = sy - y;
       if (dx * dx + dy * dy > r2) return;
       for (int s = 0; s < own.count; ++s)  // neighbours mostly pass on the same seed
         if (own.seed[s].pixel == pixel) return;
-      own.offer({label, pixel, static_cast<std::int16_t>(sx), static_cast<std::int16_t>(sy),
-                 has_point ? squared_distance(pts[i], pts[pixel]) : static_cast<float>(dx * dx + dy * dy)});
+      own.offer({point, label, pixel, static_cast<std::int16_t>(sx), static_cast<std::int16_t>(sy),
+                 has_point ? squared_distance(here, point) : static_cast<float>(dx * dx + dy * dy)});
     };
     for (const auto& d : from) {
       const int xx = x + d[0], yy = y + d[1];
       if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
       const int j = yy * width + xx;
-      if (lab[j] > 0 && lab[j] <= num_patches && valid_point(pts[j])) {
-        offer(lab[j], j, xx, yy);
+      if (patch_pixel[static_cast<size_t>(j)]) {
+        offer(pts[j], lab[j], j, xx, yy);
       } else if (slot[static_cast<size_t>(j)] >= 0) {
         const SeedSet& other = seeds[static_cast<size_t>(slot[static_cast<size_t>(j)])];
-        for (int s = 0; s < other.count; ++s) offer(other.seed[s].label, other.seed[s].pixel, other.seed[s].x, other.seed[s].y);
+        for (int s = 0; s < other.count; ++s) {
+          const Seed& t = other.seed[s];
+          offer(t.point, t.label, t.pixel, t.x, t.y);
+        }
       }
     }
   };
