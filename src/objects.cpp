@@ -115,7 +115,7 @@ double inlier_share(const std::vector<int>& pixels, const cv::Mat& points, const
 double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, double band, Plane& plane) {
   const auto* pts = points.ptr<cv::Vec3f>();
   std::vector<int> sample;
-  const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
+  const size_t stride = std::max<size_t>(1, pixels.size() / 1000);
   for (size_t k = 0; k < pixels.size(); k += stride)
     if (valid_point(pts[pixels[k]])) sample.push_back(pixels[k]);
   if (sample.size() < 10) return 0;
@@ -126,7 +126,7 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
   };
   int best_count = -1;
   Plane best;
-  for (int iteration = 0; iteration < 50; ++iteration) {
+  for (int iteration = 0; iteration < 30; ++iteration) {
     const Eigen::Vector3f a = to_eigen(pts[sample[next()]]).cast<float>();
     const Eigen::Vector3f b = to_eigen(pts[sample[next()]]).cast<float>();
     const Eigen::Vector3f c = to_eigen(pts[sample[next()]]).cast<float>();
@@ -151,7 +151,7 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
 }
 
 // Pixels visited per object when classifying it against the table (a share is all we need).
-constexpr int kSamplesPerObject = 2000;
+constexpr int kSamplesPerObject = 500;
 
 struct Heights {
   int samples = 0, in_band = 0, above_max = 0, below = 0, over_region = 0;
@@ -174,35 +174,37 @@ std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat
   const int* lab = object_labels.ptr<int>();
   const auto* pts = points.ptr<cv::Vec3f>();
 
-  std::vector<Eigen::Vector3d> sum(objects.size(), Eigen::Vector3d::Zero());
-  std::vector<Eigen::Matrix3d> outer(objects.size(), Eigen::Matrix3d::Zero());
+  // Moments in the camera frame (6 products per pixel), moved to the robot frame once per object.
+  std::vector<Eigen::Matrix<double, 9, 1>> moments(objects.size(), Eigen::Matrix<double, 9, 1>::Zero());
   std::vector<int> valid(objects.size(), 0);
   for (int i = 0; i < total; ++i) {
     if (lab[i] <= 0) continue;
     const size_t o = static_cast<size_t>(lab[i] - 1);
     ++objects[o].pixel_count;
     if (!valid_point(pts[i])) continue;
-    const Eigen::Vector3d q = rot * to_eigen(pts[i]) + shift;
-    sum[o] += q;
-    outer[o] += q * q.transpose();
+    const double x = pts[i][0], y = pts[i][1], z = pts[i][2];
+    moments[o] += (Eigen::Matrix<double, 9, 1>() << x, y, z, x * x, x * y, x * z, y * y, y * z, z * z).finished();
     ++valid[o];
   }
-  std::vector<Eigen::Matrix3d> axes(objects.size(), Eigen::Matrix3d::Identity());
+  std::vector<Eigen::Matrix3d> axes(objects.size(), Eigen::Matrix3d::Identity());  // camera frame
   std::vector<Eigen::Vector3d> low(objects.size(), Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()));
   std::vector<Eigen::Vector3d> high(objects.size(), -low[0]);
   for (size_t o = 0; o < objects.size(); ++o) {
     objects[o].id = static_cast<int>(o) + 1;
     objects[o].cut_cost = o < cut_cost.size() ? cut_cost[o] : std::numeric_limits<float>::infinity();
     if (valid[o] == 0) continue;
-    const Eigen::Vector3d mean = sum[o] / valid[o];
-    objects[o].centroid = mean.cast<float>();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer[o] / valid[o] - mean * mean.transpose());
+    const auto& m = moments[o];
+    const Eigen::Vector3d mean = m.head<3>() / valid[o];
+    Eigen::Matrix3d second;
+    second << m(3), m(4), m(5), m(4), m(6), m(7), m(5), m(7), m(8);
+    objects[o].centroid = (rot * mean + shift).cast<float>();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(second / valid[o] - mean * mean.transpose());
     axes[o] = eig.eigenvectors();
   }
   for (int i = 0; i < total; ++i) {
     if (lab[i] <= 0 || !valid_point(pts[i])) continue;
     const size_t o = static_cast<size_t>(lab[i] - 1);
-    const Eigen::Vector3d c = axes[o].transpose() * (rot * to_eigen(pts[i]) + shift);
+    const Eigen::Vector3d c = axes[o].transpose() * to_eigen(pts[i]);
     low[o] = low[o].cwiseMin(c);
     high[o] = high[o].cwiseMax(c);
   }
@@ -214,11 +216,11 @@ std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat
     std::sort(order.begin(), order.end(), [&](int a, int b) { return extent(a) > extent(b); });
     OrientedBox& box = objects[o].box;
     for (int k = 0; k < 3; ++k) {
-      box.axes.col(k) = axes[o].col(order[static_cast<size_t>(k)]).cast<float>();
+      box.axes.col(k) = (rot * axes[o].col(order[static_cast<size_t>(k)])).cast<float>();
       box.extents(k) = static_cast<float>(extent(order[static_cast<size_t>(k)]));
     }
     box.axes.col(2) = box.axes.col(0).cross(box.axes.col(1));
-    box.center = (axes[o] * (0.5 * (low[o] + high[o]))).cast<float>();
+    box.center = (rot * (axes[o] * (0.5 * (low[o] + high[o]))) + shift).cast<float>();
   }
   for (size_t p = 0; p < object_of_patch.size(); ++p) {
     const int o = object_of_patch[p];
@@ -240,19 +242,21 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
 
   // Pixels of every object, visited with a stride (bounded work per object and candidate).
   std::vector<std::vector<int>> samples(objects.size());
+  int valid_total = 0;
   {
-    std::vector<int> stride(objects.size());
+    std::vector<int> stride(objects.size()), countdown(objects.size(), 0);
     for (size_t o = 0; o < objects.size(); ++o) stride[o] = std::max(1, objects[o].pixel_count / kSamplesPerObject);
-    std::vector<int> seen(objects.size(), 0);
     for (int i = 0; i < total; ++i) {
       const int o = object_of_pixel(i);
-      if (o < 0 || !valid_point(pts[i])) continue;
-      if (seen[static_cast<size_t>(o)]++ % stride[static_cast<size_t>(o)] == 0) samples[static_cast<size_t>(o)].push_back(i);
+      if (o < 0) continue;
+      ++valid_total;
+      if (!valid_point(pts[i]) || countdown[static_cast<size_t>(o)]-- > 0) continue;
+      countdown[static_cast<size_t>(o)] = stride[static_cast<size_t>(o)] - 1;
+      samples[static_cast<size_t>(o)].push_back(i);
     }
   }
-  const int valid_total = cv::countNonZero(object_labels > 0);
 
-  // Candidates: large flat patches, largest first (at most 8 are scored).
+  // Candidates: large flat patches, largest first (at most 4 are scored).
   std::vector<int> candidates;
   std::vector<Plane> planes(patches.size());
   std::vector<bool> flat(patches.size(), false);
@@ -264,7 +268,7 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
   std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
     return patches[static_cast<size_t>(a)].pixels.size() > patches[static_cast<size_t>(b)].pixels.size();
   });
-  if (candidates.size() > 8) candidates.resize(8);
+  if (candidates.size() > 4) candidates.resize(4);
   if (candidates.empty()) return std::nullopt;
   std::vector<int> candidate_of_pixel(static_cast<size_t>(total), -1);
   for (size_t k = 0; k < candidates.size(); ++k)
