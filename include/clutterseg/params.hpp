@@ -100,7 +100,7 @@ struct Params {
     double contact_distance = 0.05;  // an object rests on a plane when its lowest point is this close [m]
     double region_margin = 0.05; // an object stands on the table when it projects within this of the
                                  // table's visible region (convex hull in the plane) [m]
-    double wall_min_extent = 0.5;  // a flat object at least this large, roughly perpendicular to the
+    double wall_min_extent = 0.35; // a flat object at least this large, roughly perpendicular to the
                                    // table (> 60 deg), is a wall [m]
   } support;
 
