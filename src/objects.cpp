@@ -364,6 +364,73 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
   return plane;
 }
 
+int split_support(cv::Mat& object_labels, std::vector<Object>& objects, const Plane& table, const cv::Mat& points,
+                  const Params::Support& params, int min_px, const Camera& camera) {
+  if (object_labels.type() != CV_32S || points.type() != CV_32FC3 || object_labels.size() != points.size())
+    throw Error("split_support: labels must be CV_32S and points CV_32FC3 of the same size");
+  cv::Mat clear(object_labels.size(), CV_8U, cv::Scalar(0));
+  const int num_objects = static_cast<int>(objects.size());
+  const int total = static_cast<int>(object_labels.total());
+  int* lab = object_labels.ptr<int>();
+  const auto* pts = points.ptr<cv::Vec3f>();
+  uchar* mask = clear.ptr<uchar>();
+  for (int i = 0; i < total; ++i) {
+    if (lab[i] <= 0 || lab[i] > num_objects || !objects[static_cast<size_t>(lab[i] - 1)].support || !valid_point(pts[i])) continue;
+    const float h = table.distance(to_eigen(pts[i]).cast<float>());
+    mask[i] = h > params.plane_band && h <= params.max_height ? 255 : 0;
+  }
+  // Groups: 8-connected, and neighbours closer than plane_band in 3D (a box in front of a keyboard is
+  // not one object with it). Each pixel enters the queue once: bounded.
+  std::vector<int> group(static_cast<size_t>(total), 0), queue;
+  const float link2 = static_cast<float>(params.plane_band * params.plane_band);
+  const int width = object_labels.cols, height = object_labels.rows;
+  int next = num_objects, added = 0;
+  std::vector<std::vector<int>> new_pixels;
+  for (int start = 0; start < total; ++start) {
+    if (!mask[start] || group[static_cast<size_t>(start)]) continue;
+    queue.assign(1, start);
+    group[static_cast<size_t>(start)] = -1;
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int i = queue[head], x = i % width, y = i / width;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = x + dx, yy = y + dy, j = yy * width + xx;
+          if (xx < 0 || yy < 0 || xx >= width || yy >= height || !mask[j] || group[static_cast<size_t>(j)]) continue;
+          const cv::Vec3f d = pts[i] - pts[j];
+          if (d.dot(d) >= link2) continue;
+          group[static_cast<size_t>(j)] = -1;
+          queue.push_back(j);
+        }
+    }
+    const int id = static_cast<int>(queue.size()) >= min_px ? ++next : 0;
+    added += id > 0;
+    if (id) new_pixels.push_back(queue);
+    for (int i : queue) {
+      group[static_cast<size_t>(i)] = 1;  // visited
+      if (id) lab[i] = id;
+    }
+  }
+  if (added == 0) return 0;
+  // Statistics of every object again (the support objects lost pixels); flags and patches are kept.
+  std::vector<Object> described = describe_objects(object_labels, points, {}, {}, camera);
+  for (size_t o = 0; o < objects.size(); ++o) {
+    described[o].patches = std::move(objects[o].patches);
+    described[o].cut_cost = objects[o].cut_cost;
+    described[o].support = objects[o].support;
+    described[o].background = objects[o].background;
+  }
+  objects = std::move(described);
+  // A wall standing on the table's edge came with it: large, flat and perpendicular to the table.
+  for (size_t k = 0; k < new_pixels.size(); ++k) {
+    Object& object = objects[static_cast<size_t>(num_objects) + k];
+    Plane own;
+    object.background = object.box.extents(0) >= params.wall_min_extent && fit_plane(new_pixels[k], points, own) &&
+                        inlier_share(new_pixels[k], points, own, params.plane_band) >= 0.9 &&
+                        std::abs(own.normal.dot(table.normal)) < std::cos(60.0 * M_PI / 180.0);
+  }
+  return added;
+}
+
 cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects) {
   // New ids keep the order of the old ones, so the view is as stable as the labels it comes from.
   std::vector<int> new_id(objects.size() + 1, 0);

@@ -125,6 +125,8 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   watch.mark("remaining");
   r.objects = describe_objects(r.object_labels, r.points, parts.object_of_patch, parts.cut_cost, camera);  // objects
   r.support_plane = find_support(r.objects, r.patches, r.object_labels, r.points, p.support);   // table, walls
+  if (r.support_plane)                                                           // objects merged into it
+    split_support(r.object_labels, r.objects, *r.support_plane, r.points, p.support, px.area(p.patches.min_size_px), camera);
   watch.mark("objects");
   watch.total();
   return r;

@@ -109,3 +109,21 @@ TEST(Objects, StackedBoxesStaySeparateAndSameInputGivesSameLabels) {
   EXPECT_NE(majority(1), majority(2));
   EXPECT_NE(majority(1), majority(0));
 }
+
+TEST(Objects, ObjectMergedIntoTheTableIsSplitOff) {
+  // As if the edges had not separated box and table: one object, the support.
+  const auto scene = scenes::box_on_plane();
+  const auto truth = scene.render();
+  const Result r = run(scene, truth);
+  ASSERT_TRUE(r.support_plane.has_value());
+  cv::Mat labels(r.object_labels.size(), CV_32S, cv::Scalar(0));
+  labels.setTo(1, truth.depth > 0);
+  std::vector<Object> objects = describe_objects(labels, r.points, {}, {}, scene.camera);
+  objects[0].support = true;
+  EXPECT_EQ(split_support(labels, objects, *r.support_plane, r.points, Params::Support{}, 50, scene.camera), 1);
+  ASSERT_EQ(objects.size(), 2u);
+  EXPECT_FALSE(objects[1].support || objects[1].background);
+  const cv::Mat view = objects_only(labels, objects);
+  EXPECT_GT(kept_share(view, truth.labels, 1, truth.depth), 0.8);  // the box but its bottom 15 mm
+  EXPECT_LT(kept_share(view, truth.labels, 0, truth.depth), 0.01);
+}
