@@ -127,3 +127,18 @@ TEST(Objects, ObjectMergedIntoTheTableIsSplitOff) {
   EXPECT_GT(kept_share(view, truth.labels, 1, truth.depth), 0.8);  // the box but its bottom 15 mm
   EXPECT_LT(kept_share(view, truth.labels, 0, truth.depth), 0.01);
 }
+
+TEST(Objects, SameLabelsForAnyThreadCount) {
+  const auto scene = scenes::occluded_box();
+  const auto truth = scene.render();
+  Params p;
+  p.smoothing.temporal = false;
+  p.threads = 1;
+  const Result one = segment(truth.depth, scene.camera, p);
+  p.threads = 2;
+  const Result two = segment(truth.depth, scene.camera, p);
+  EXPECT_EQ(cv::countNonZero(one.object_labels != two.object_labels), 0);
+  EXPECT_EQ(cv::countNonZero(one.patch_labels != two.patch_labels), 0);
+  ASSERT_EQ(one.objects.size(), two.objects.size());
+  for (size_t i = 0; i < one.objects.size(); ++i) EXPECT_EQ(one.objects[i].centroid, two.objects[i].centroid);
+}
