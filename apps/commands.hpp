@@ -6,5 +6,7 @@
 namespace clutterseg::app {
 
 void add_segment_command(CLI::App& app);
+void add_eval_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 }  // namespace clutterseg::app

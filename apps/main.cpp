@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   app.add_flag("--dump-config", dump_config, "print every parameter with its default as JSON and exit");
   app.set_version_flag("--version", "clutterseg 0.1.0");
   app::add_segment_command(app);
+  app::add_eval_command(app);
+  app::add_bench_command(app);
   try {
     app.parse(argc, argv);
     if (dump_config) {

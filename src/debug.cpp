@@ -72,10 +72,11 @@ cv::Mat render_overlay(const cv::Mat& labels, const cv::Mat& color, const cv::Ma
   cv::Mat dim = base * 0.5;
   dim.copyTo(overlay, labels == 0);
   // Thin dark outline around every label for legibility.
-  cv::Mat grow, shrink, as_float;  // morphology has no CV_32S: float holds ids up to 2^24 exactly
-  labels.convertTo(as_float, CV_32F);
-  cv::dilate(as_float, grow, cv::Mat());
-  cv::erode(as_float, shrink, cv::Mat());
+  // OpenCV morphology has no int32 kernel; float holds every id below 2^24 exactly.
+  cv::Mat ids, grow, shrink;
+  labels.convertTo(ids, CV_32F);
+  cv::dilate(ids, grow, cv::Mat());
+  cv::erode(ids, shrink, cv::Mat());
   overlay.setTo(cv::Scalar(20, 20, 20), (grow != shrink) & (labels > 0));
   return overlay;
 }

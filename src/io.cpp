@@ -24,6 +24,16 @@ fs::path temporary_beside(const fs::path& path) {
   return path.parent_path() / (path.stem().string() + ".partial" + path.extension().string());
 }
 
+// Moves the finished temporary file into place; on failure removes it, so nothing is left behind.
+void replace_with(const fs::path& tmp, const fs::path& path) {
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    fail(path, "cannot be written (" + ec.message() + ")");
+  }
+}
+
 }  // namespace
 
 Camera read_camera_json(const fs::path& path) {
@@ -111,7 +121,7 @@ void write_png_atomic(const fs::path& path, const cv::Mat& image) {
     fs::remove(tmp, ec);
     fail(path, "cannot be written");
   }
-  fs::rename(tmp, path);
+  replace_with(tmp, path);
 }
 
 void write_text_atomic(const fs::path& path, const std::string& text) {
@@ -126,7 +136,7 @@ void write_text_atomic(const fs::path& path, const std::string& text) {
       fail(path, "cannot be written");
     }
   }
-  fs::rename(tmp, path);
+  replace_with(tmp, path);
 }
 
 cv::Mat labels_to_u16(const cv::Mat& labels) {

@@ -14,10 +14,13 @@ cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera) {
   parallel_for_rows(depth.rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y) {
       const float* z = depth.ptr<float>(y);
-      auto* p = points.ptr<cv::Vec3f>(y);
-      const float ry = (y - cy) * ify;
-      for (int x = 0; x < depth.cols; ++x)
-        p[x] = z[x] > 0 ? cv::Vec3f((x - cx) * ifx * z[x], ry * z[x], z[x]) : cv::Vec3f(0, 0, 0);
+      float* p = points.ptr<float>(y);
+      const float ry = (static_cast<float>(y) - cy) * ify;
+      for (int x = 0; x < depth.cols; ++x) {  // (0,0,0) where z = 0
+        p[3 * x] = (static_cast<float>(x) - cx) * ifx * z[x];
+        p[3 * x + 1] = ry * z[x];
+        p[3 * x + 2] = z[x];
+      }
     }
   });
   return points;
@@ -30,60 +33,74 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
 
 namespace {
 
-// Difference across p along one axis: central if both neighbours continue the surface, else one-sided.
-inline bool tangent(const cv::Vec3f& p, const cv::Vec3f* prev, const cv::Vec3f* next, float limit,
-                    cv::Vec3f& t) {
-  const float lim = limit * p[2];
-  const bool has_prev = prev && (*prev)[2] > 0 && std::abs((*prev)[2] - p[2]) <= lim;
-  const bool has_next = next && (*next)[2] > 0 && std::abs((*next)[2] - p[2]) <= lim;
-  if (has_prev && has_next) t = *next - *prev;
-  else if (has_next) t = *next - p;
-  else if (has_prev) t = p - *prev;
-  else return false;
-  return true;
+// One row of raw normals. Plain pointers and values (no captures) so that the loop vectorises.
+void raw_normal_row(const float* __restrict up, const float* __restrict mid, const float* __restrict down,
+                    const float* __restrict rx, float ry, float ry_up, float ry_down, int cols, int s,
+                    float jump_limit, float* __restrict nx, float* __restrict ny, float* __restrict nz) {
+  for (int x = 0; x < cols; ++x) {
+    const float z = mid[x], lim = jump_limit * z;
+    const float zl = mid[x - s], zr = mid[x + s], zu = up[x], zd = down[x];
+    // 1 where the neighbour continues the surface, else 0 (arithmetic blends vectorise).
+    const float l = (zl > 0.f) & (std::abs(zl - z) <= lim) ? 1.f : 0.f;
+    const float r = (zr > 0.f) & (std::abs(zr - z) <= lim) ? 1.f : 0.f;
+    const float u = (zu > 0.f) & (std::abs(zu - z) <= lim) ? 1.f : 0.f;
+    const float d = (zd > 0.f) & (std::abs(zd - z) <= lim) ? 1.f : 0.f;
+    const float px = rx[x] * z, py = ry * z;
+    // Horizontal tangent a - b, vertical tangent c - e; a missing neighbour is replaced by the centre.
+    const float ax = px + r * (rx[x + s] * zr - px), ay = py + r * (ry * zr - py), az = z + r * (zr - z);
+    const float bx = px + l * (rx[x - s] * zl - px), by = py + l * (ry * zl - py), bz = z + l * (zl - z);
+    const float cx = px + d * (rx[x] * zd - px), cy = py + d * (ry_down * zd - py), cz = z + d * (zd - z);
+    const float ex = px + u * (rx[x] * zu - px), ey = py + u * (ry_up * zu - py), ez = z + u * (zu - z);
+    const float tux = ax - bx, tuy = ay - by, tuz = az - bz;
+    const float tvx = cx - ex, tvy = cy - ey, tvz = cz - ez;
+    // tv x tu faces the camera for any surface seen from the front (x right, y down, z forward).
+    const float n0 = tvy * tuz - tvz * tuy, n1 = tvz * tux - tvx * tuz, n2 = tvx * tuy - tvy * tux;
+    const float len2 = n0 * n0 + n1 * n1 + n2 * n2;
+    const float inv = ((z > 0) & (len2 > 0)) ? 1.f / std::sqrt(len2) : 0.f;
+    nx[x] = n0 * inv;
+    ny[x] = n1 * inv;
+    nz[x] = n2 * inv;
+  }
 }
 
 }  // namespace
 
-cv::Mat compute_normals(const cv::Mat& points, int step, int ksize, float jump_limit) {
-  const int rows = points.rows, cols = points.cols;
-  cv::Mat raw(points.size(), CV_32FC3, cv::Scalar::all(0));
+cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit) {
+  const int rows = depth.rows, cols = depth.cols, s = step;
+  // Zero padding: a neighbour outside the image is "no measurement", like a hole.
+  cv::Mat padded;
+  cv::copyMakeBorder(depth, padded, s, s, s, s, cv::BORDER_CONSTANT, cv::Scalar(0));
+  std::vector<float> ray_x(static_cast<size_t>(cols + 2 * s));  // (u - cx) / fx per padded column
+  for (int u = 0; u < cols + 2 * s; ++u) ray_x[static_cast<size_t>(u)] = static_cast<float>((u - s - camera.cx) / camera.fx);
+  const auto ray_y = [&](int v) { return static_cast<float>((v - camera.cy) / camera.fy); };
+
+  cv::Mat planes[3] = {cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F)};
+  parallel_for_rows(rows, [&](int begin, int end) {
+    for (int y = begin; y < end; ++y)
+      raw_normal_row(padded.ptr<float>(y) + s, padded.ptr<float>(y + s) + s, padded.ptr<float>(y + 2 * s) + s,
+                     ray_x.data() + s, ray_y(y), ray_y(y - s), ray_y(y + s), cols, s, jump_limit,
+                     planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
+  });
+  if (ksize > 1)
+    for (auto& p : planes) cv::GaussianBlur(p, p, cv::Size(ksize, ksize), 0, 0, cv::BORDER_REPLICATE);
   parallel_for_rows(rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y) {
-      const auto* row = points.ptr<cv::Vec3f>(y);
-      const auto* up = y >= step ? points.ptr<cv::Vec3f>(y - step) : nullptr;
-      const auto* down = y + step < rows ? points.ptr<cv::Vec3f>(y + step) : nullptr;
-      auto* out = raw.ptr<cv::Vec3f>(y);
+      const float* z = depth.ptr<float>(y);
+      float* nx = planes[0].ptr<float>(y);
+      float* ny = planes[1].ptr<float>(y);
+      float* nz = planes[2].ptr<float>(y);
       for (int x = 0; x < cols; ++x) {
-        const cv::Vec3f& p = row[x];
-        if (p[2] <= 0) continue;
-        cv::Vec3f tu, tv;
-        if (!tangent(p, x >= step ? &row[x - step] : nullptr, x + step < cols ? &row[x + step] : nullptr,
-                     jump_limit, tu) ||
-            !tangent(p, up ? &up[x] : nullptr, down ? &down[x] : nullptr, jump_limit, tv))
-          continue;
-        cv::Vec3f n = tu.cross(tv);
-        const float len = static_cast<float>(cv::norm(n));
-        if (len <= 0) continue;
-        n *= (n.dot(p) > 0 ? -1.f : 1.f) / len;  // face the camera
-        out[x] = n;
+        const float len2 = nx[x] * nx[x] + ny[x] * ny[x] + nz[x] * nz[x];
+        const float inv = ((z[x] > 0) & (len2 > 1e-12f)) ? 1.f / std::sqrt(len2) : 0.f;
+        nx[x] *= inv;
+        ny[x] *= inv;
+        nz[x] *= inv;
       }
     }
   });
-  cv::Mat smooth;
-  if (ksize > 1) cv::GaussianBlur(raw, smooth, cv::Size(ksize, ksize), 0, 0, cv::BORDER_REPLICATE);
-  else smooth = raw;
-  parallel_for_rows(rows, [&](int begin, int end) {
-    for (int y = begin; y < end; ++y) {
-      auto* n = smooth.ptr<cv::Vec3f>(y);
-      const auto* r = raw.ptr<cv::Vec3f>(y);
-      for (int x = 0; x < cols; ++x) {
-        const float len = static_cast<float>(cv::norm(n[x]));
-        n[x] = (r[x][2] != 0 && len > 1e-6f) ? n[x] / len : cv::Vec3f(0, 0, 0);
-      }
-    }
-  });
-  return smooth;
+  cv::Mat normals;
+  cv::merge(planes, 3, normals);
+  return normals;
 }
 
 }  // namespace clutterseg

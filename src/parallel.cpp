@@ -1,5 +1,7 @@
 #include "clutterseg/parallel.hpp"
 
+#include <opencv2/core/utility.hpp>
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -7,6 +9,8 @@
 namespace clutterseg {
 
 void set_threads(int threads) {
+  // OpenCV's own pool (GaussianBlur, medianBlur, ...) follows the same setting.
+  cv::setNumThreads(threads > 0 ? threads : -1);
 #ifdef _OPENMP
   omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs());
 #else

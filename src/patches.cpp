@@ -54,12 +54,9 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     }
     p.centroid = (c / static_cast<double>(p.pixels.size())).cast<float>();
     p.mean_normal = n.norm() > 0 ? Eigen::Vector3f(n.normalized().cast<float>()) : Eigen::Vector3f(0, 0, -1);
-    double angle_sum = 0;
-    for (int i : p.pixels) {
-      const double d = std::clamp<double>(p.mean_normal.dot(Eigen::Vector3f(nrm[i][0], nrm[i][1], nrm[i][2])), -1.0, 1.0);
-      angle_sum += std::acos(d);
-    }
-    p.spread_deg = static_cast<float>(angle_sum / static_cast<double>(p.pixels.size()) * 180.0 / M_PI);
+    // Mean angular deviation, taken as the angle of the mean normal's length: |mean of unit normals|
+    // = mean cos(deviation) for small spreads; one acos per patch instead of one per pixel.
+    p.spread_deg = static_cast<float>(std::acos(std::clamp(n.norm() / static_cast<double>(p.pixels.size()), 0.0, 1.0)) * 180.0 / M_PI);
     p.histogram = normal_histogram(normals, p.pixels, params.histogram_bins);
     p.occupied_bins = static_cast<int>(std::count_if(p.histogram.begin(), p.histogram.end(),
         [&](float h) { return h >= params.occupied_share; }));

@@ -28,25 +28,25 @@ cv::Mat median_depth(const cv::Mat& depth) {
   // so that missing data neither spreads nor drags a surface towards zero.
   cv::Mat out;
   cv::medianBlur(depth, out, 3);
+  // Pixels within one pixel of a hole (found with an erosion of the valid mask) are redone over their
+  // valid neighbours only; OpenCV's median replicates the border, so border pixels are redone too.
+  cv::Mat valid = depth > 0, redo;
+  cv::erode(valid, redo, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  redo = valid & ~redo;
   const int rows = depth.rows, cols = depth.cols;
   parallel_for_rows(rows, [&](int begin, int end) {
     float v[9];
     for (int y = begin; y < end; ++y) {
       float* o = out.ptr<float>(y);
-      const float* c = depth.ptr<float>(y);
+      const uchar* r = redo.ptr<uchar>(y);
+      const uchar* ok = valid.ptr<uchar>(y);
       for (int x = 0; x < cols; ++x) {
-        if (c[x] <= 0) { o[x] = 0; continue; }
-        bool hole = y == 0 || x == 0 || y == rows - 1 || x == cols - 1;
-        for (int dy = -1; dy <= 1 && !hole; ++dy)
-          for (int dx = -1; dx <= 1; ++dx)
-            if (depth.at<float>(y + dy, x + dx) <= 0) { hole = true; break; }
-        if (!hole) continue;
+        if (!ok[x]) { o[x] = 0; continue; }
+        if (!r[x]) continue;
         int n = 0;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int yy = y + dy, xx = x + dx;
-            if (yy < 0 || xx < 0 || yy >= rows || xx >= cols) continue;
-            const float z = depth.at<float>(yy, xx);
+        for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, rows - 1); ++yy)
+          for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, cols - 1); ++xx) {
+            const float z = depth.ptr<float>(yy)[xx];
             if (z > 0) v[n++] = z;
           }
         std::nth_element(v, v + n / 2, v + n);
@@ -67,24 +67,26 @@ cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& pa
   const int n = static_cast<int>(window_.size());
   std::vector<const cv::Mat*> frames;
   for (const auto& f : window_) frames.push_back(&f);
+  const float band_k = static_cast<float>(params.temporal_band);
   parallel_for_rows(depth.rows, [&](int begin, int end) {
-    std::vector<const float*> row(n);
+    std::vector<float> count(static_cast<size_t>(depth.cols));
     for (int y = begin; y < end; ++y) {
-      for (int i = 0; i < n; ++i) row[i] = frames[i]->ptr<float>(y);
-      const float* newest = row[n - 1];
-      float* o = out.ptr<float>(y);
-      for (int x = 0; x < depth.cols; ++x) {
-        const float z = newest[x];
-        if (z <= 0) { o[x] = 0; continue; }
-        const float band = static_cast<float>(params.temporal_band) * z * z;
-        float sum = 0;
-        int count = 0;
-        for (int i = 0; i < n; ++i) {
-          const float v = row[i][x];
-          if (v > 0 && std::abs(v - z) <= band) { sum += v; ++count; }
+      const float* newest = frames.back()->ptr<float>(y);
+      float* sum = out.ptr<float>(y);
+      std::fill(sum, sum + depth.cols, 0.f);
+      std::fill(count.begin(), count.end(), 0.f);
+      // Frame by frame over whole rows, branch-free, so that it vectorises.
+      for (int i = 0; i < n; ++i) {
+        const float* v = frames[static_cast<size_t>(i)]->ptr<float>(y);
+        for (int x = 0; x < depth.cols; ++x) {
+          const float z = newest[x];
+          const bool take = (v[x] > 0) & (std::abs(v[x] - z) <= band_k * z * z);
+          sum[x] += take ? v[x] : 0.f;
+          count[static_cast<size_t>(x)] += take ? 1.f : 0.f;
         }
-        o[x] = sum / count;  // count >= 1: the newest value is always within its own band
       }
+      // The newest value is within its own band, so count >= 1 wherever it is valid.
+      for (int x = 0; x < depth.cols; ++x) sum[x] = newest[x] > 0 ? sum[x] / count[static_cast<size_t>(x)] : 0.f;
     }
   });
   return out;

@@ -100,4 +100,28 @@ inline TestScene box_before_wall() {
   return s;
 }
 
+// Two boxes of equal height with table between them: co-planar tops separated by background
+// (paper Fig. 5, red box), which must not be joined.
+inline TestScene separate_boxes() {
+  return {{{table(), box(1, {-0.12, 0, 0.05}, {0.06, 0.05, 0.05}), box(2, {0.12, 0, 0.05}, {0.06, 0.05, 0.05})}}};
+}
+
+// A box whose front and top faces are each cut in two by a tall thin box in front of it: the camera
+// sees over occluded_box()'s occluder, this one hides the full height of the face.
+inline TestScene occluded_box_split() {
+  return {{{table(), box(1, {0, 0.08, 0.06}, {0.15, 0.05, 0.06}), box(2, {0, -0.08, 0.15}, {0.025, 0.025, 0.15})}}};
+}
+
+// Two lying cylinders on one axis with bare table between them: aligned, similar, but not occluded.
+inline TestScene coaxial_cylinders() {
+  return {{{table(), lying_cylinder(1, {-0.11, 0.05, 0.04}, 0.04, 0.07), lying_cylinder(2, {0.11, 0.05, 0.04}, 0.04, 0.07)}}};
+}
+
+// The lying cylinder cut by an occluder, with a standing cylinder and a sphere beside it (paper Fig. 6).
+inline TestScene curved_objects() {
+  return {{{table(), lying_cylinder(1, {0, 0.05, 0.04}, 0.04, 0.16), box(2, {0, -0.07, 0.1}, {0.025, 0.025, 0.1}),
+            standing(ShapeType::Cylinder, 3, {-0.2, -0.12, 0}, 0.035, 0.16),
+            standing(ShapeType::Sphere, 4, {0.2, -0.12, 0}, 0.05, 0.1)}}};
+}
+
 }  // namespace clutterseg::scenes

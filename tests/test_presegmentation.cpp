@@ -47,7 +47,7 @@ TEST(Temporal, AveragesStaticNoiseAndKeepsMotion) {
 TEST(Normals, PlaneFacingTheCameraAndTiltedPlane) {
   Camera cam = synth::default_camera(64, 48);
   cv::Mat flat(48, 64, CV_32F, cv::Scalar(1.0f));
-  cv::Mat n = compute_normals(depth_to_points(flat, cam), 1, 5, 0.1f);
+  cv::Mat n = compute_normals(flat, cam, 1, 5, 0.1f);
   cv::Vec3f c = n.at<cv::Vec3f>(24, 32);
   EXPECT_NEAR(c[2], -1.0, 1e-4);
   // Plane z = 1 + 0.5 y (tilted about the x axis): normal (0, -0.5, 1) normalised, facing the camera.
@@ -57,7 +57,7 @@ TEST(Normals, PlaneFacingTheCameraAndTiltedPlane) {
       const double ry = (v - cam.cy) / cam.fy;  // z = 1 + 0.5 * ry * z
       tilted.at<float>(v, u) = static_cast<float>(1.0 / (1.0 - 0.5 * ry));
     }
-  n = compute_normals(depth_to_points(tilted, cam), 1, 5, 0.1f);
+  n = compute_normals(tilted, cam, 1, 5, 0.1f);
   c = n.at<cv::Vec3f>(24, 32);
   const Eigen::Vector3f expected = Eigen::Vector3f(0, 0.5f, -1).normalized();
   EXPECT_NEAR(c[1], expected.y(), 1e-3);
@@ -71,7 +71,7 @@ TEST(Edges, PlaneHasNoEdgesAndAStepHasOne) {
   auto edges_of = [&](const cv::Mat& depth) {
     const cv::Mat pts = depth_to_points(depth, cam);
     const float jump = relative_jump_limit(pe, 1, cam);
-    return edge_mask(normal_edge_value(compute_normals(pts, 1, 5, jump), 1), pts, pe.theta, jump);
+    return edge_mask(normal_edge_value(compute_normals(depth, cam, 1, 5, jump), 1), depth, pe.theta, jump);
   };
   EXPECT_EQ(cv::countNonZero(edges_of(d)), 0);
   d(cv::Rect(32, 0, 32, 48)).setTo(0.8f);  // a 20 cm step

@@ -10,9 +10,10 @@ namespace clutterseg {
 // smaller at creases. Pixels without a normal get 0; neighbours without a normal count as 0.
 cv::Mat normal_edge_value(const cv::Mat& normals, int step);
 
-// Binary edge image (CV_8U, 255 = edge): edge value below theta, no measurement, or a depth jump
+// Binary edge image (CV_8U, 255 = edge) from the edge value and the depth (CV_32F metres): edge value
+// below theta, no measurement, or a depth jump
 // to any of the 8 immediate neighbours larger than jump_limit * z (relative_jump_limit for step 1):
 // discontinuities are tested between adjacent pixels, where the median keeps them sharp.
-cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& points, double theta, float jump_limit);
+cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& depth, double theta, float jump_limit);
 
 }  // namespace clutterseg

@@ -12,11 +12,12 @@ cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera);
 // Largest |z(q) - z(p)| / z(p) between pixels `step` apart that is not a depth discontinuity.
 float relative_jump_limit(const Params::Edges& params, int step, const Camera& camera);
 
-// Normals (CV_32FC3, unit, facing the camera; (0,0,0) = none) from the cross product of the
-// horizontal and vertical neighbour differences at distance `step`, then a Gaussian of size `ksize`
-// and renormalisation. A difference across a depth discontinuity (jump_limit, relative to z) falls
-// back to the one-sided difference. step and ksize are the resolution-scaled values.
-cv::Mat compute_normals(const cv::Mat& points, int step, int ksize, float jump_limit);
+// Normals (CV_32FC3, unit, facing the camera; (0,0,0) = none) of the organized 3D points of `depth`
+// (CV_32F metres): the cross product of the horizontal and vertical neighbour differences at distance
+// `step`, then a Gaussian of size `ksize` and renormalisation. A difference across a depth
+// discontinuity (jump_limit, relative to z) falls back to the one-sided difference. step and ksize are
+// the scaled values (PixelScale).
+cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit);
 
 
 }  // namespace clutterseg

@@ -1,0 +1,276 @@
+// clutterseg bench DATASET [--with lccp,organized]: per-frame time of clutterseg and its PCL peers on the
+// same frames in one run, and clutterseg's per-stage times (the layout of the paper's Table III).
+#include <opencv2/core/utility.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <time.h>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "clutterseg/io.hpp"
+#include "clutterseg/parallel.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+#include "methods.hpp"
+
+namespace clutterseg::app {
+
+namespace {
+
+struct BenchOptions {
+  std::string dataset, with, out;
+  int frames = 0;   // 0 = all
+  int warmup = 1;   // frames run before timing starts
+  int repeat = 0;   // passes over the frames; 0 = enough for at least 20 timed frames
+  CameraOptions camera;
+  ParamOptions params;
+};
+
+// One timed configuration: a method at a thread count.
+struct Runner {
+  std::string label;  // as shown in the table
+  int threads = 1;
+  Method method;
+  std::vector<double> frame_ms;                         // wall time of each timed call
+  std::vector<double> cpu_ms;                           // CPU time of the calling thread (1-thread runs)
+  std::map<std::string, std::vector<double>> stage_ms;  // the method's own per-stage times
+  std::vector<std::string> stage_order;
+  int failures = 0;
+};
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size())));  // nearest rank
+  return v[std::clamp<size_t>(rank, 1, v.size()) - 1];
+}
+
+std::string fmt(double ms) {
+  if (std::isnan(ms)) return "-";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(ms < 10 ? 2 : 1) << ms;
+  return s.str();
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      return colon == std::string::npos ? line : line.substr(colon + 2);
+    }
+  return "unknown CPU";
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  std::ostringstream s;
+  s << std::put_time(&tm, "%Y-%m-%d %H:%M UTC");
+  return s.str();
+}
+
+std::vector<std::string> split_names(const std::string& list) {
+  std::vector<std::string> names;
+  std::stringstream in(list);
+  for (std::string name; std::getline(in, name, ',');)
+    if (!name.empty()) names.push_back(name);
+  return names;
+}
+
+// Both OpenMP (clutterseg's stages) and OpenCV's own pool (median, Gaussian) follow the thread count.
+void use_threads(int threads) {
+  set_threads(threads);
+  cv::setNumThreads(threads == 1 ? 0 : threads);  // 0 = OpenCV runs sequentially
+}
+
+// CPU time of the calling thread: on a shared machine it leaves out the time the thread waited for a core.
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+void run_once(Runner& r, const Frame& frame, bool timed) {
+  use_threads(r.threads);
+  const double cpu_start = thread_cpu_ms();
+  const auto start = std::chrono::steady_clock::now();
+  MethodOutput out;
+  try {
+    out = r.method.run(frame);
+  } catch (const Error& e) {
+    if (timed) ++r.failures;
+    report_error(frame.path.string() + ": " + r.label + ": " + e.what());
+    return;
+  }
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double cpu = thread_cpu_ms() - cpu_start;
+  if (!timed) return;
+  r.frame_ms.push_back(ms);
+  if (r.threads == 1) r.cpu_ms.push_back(cpu);
+  for (const auto& [stage, t] : out.timings_ms) {
+    if (!r.stage_ms.count(stage)) r.stage_order.push_back(stage);
+    r.stage_ms[stage].push_back(t);
+  }
+}
+
+std::string command_line(const BenchOptions& o) {
+  std::string c = "clutterseg bench " + o.dataset;
+  if (!o.with.empty()) c += " --with " + o.with;
+  if (o.params.threads) c += " --threads " + std::to_string(*o.params.threads);
+  if (o.frames) c += " --frames " + std::to_string(o.frames);
+  if (o.warmup != 1) c += " --warmup " + std::to_string(o.warmup);
+  if (o.repeat) c += " --repeat " + std::to_string(o.repeat);
+  if (!o.params.config_file.empty()) c += " --config " + o.params.config_file;
+  if (!o.out.empty()) c += " --out " + o.out;
+  return c;
+}
+
+std::string report(const BenchOptions& o, const std::vector<Runner>& runners, const std::vector<Frame>& frames,
+                   int passes, int cores) {
+  std::ostringstream md;
+  const Runner& reference = runners.front();  // clutterseg at the comparison thread count
+  const double ref_median = percentile(reference.frame_ms, 0.5);
+  md << "### `" << command_line(o) << "`\n\n";
+  md << "- date: " << utc_now() << "\n";
+  md << "- machine: " << cores << " cores (nproc), " << cpu_model() << "\n";
+  md << "- frames: " << frames.size() << " of " << frames.front().depth.cols << "x" << frames.front().depth.rows
+     << ", " << passes << " pass(es) timed after " << o.warmup << " warm-up frame(s) per method\n";
+  md << "- times are wall-clock per frame (load, I/O excluded); CPU = CPU time of the calling thread, for one-thread "
+        "runs only (all their work runs on that thread)\n\n";
+  const double ref_cpu = percentile(reference.cpu_ms, 0.5);
+  md << "| method | threads | frames | median [ms] | p95 [ms] | median / clutterseg | CPU median [ms] | CPU / clutterseg |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const Runner& r : runners) {
+    const double median = percentile(r.frame_ms, 0.5);
+    md << "| " << r.label << " | " << r.threads << " | " << r.frame_ms.size()
+       << (r.failures ? " (" + std::to_string(r.failures) + " failed)" : std::string()) << " | " << fmt(median)
+       << " | " << fmt(percentile(r.frame_ms, 0.95)) << " | ";
+    md << (ref_median > 0 && !std::isnan(median) ? fmt(median / ref_median) + "x" : std::string("-")) << " | ";
+    const double cpu = percentile(r.cpu_ms, 0.5);
+    md << fmt(cpu) << " | " << (ref_cpu > 0 && !std::isnan(cpu) ? fmt(cpu / ref_cpu) + "x" : std::string("-")) << " |\n";
+  }
+  // clutterseg per stage, single- and multi-threaded side by side.
+  std::vector<const Runner*> ours;
+  for (const Runner& r : runners)
+    if (r.method.name == "clutterseg") ours.push_back(&r);
+  md << "\nclutterseg per stage [ms] (median / p95 over the timed frames):\n\n| stage |";
+  for (const Runner* r : ours) md << " " << r->threads << " thread" << (r->threads == 1 ? "" : "s") << " median | p95 |";
+  md << "\n|---|";
+  for (size_t i = 0; i < ours.size(); ++i) md << "---:|---:|";
+  md << "\n";
+  for (const auto& stage : ours.front()->stage_order) {
+    md << "| " << stage << " |";
+    for (const Runner* r : ours) {
+      const auto it = r->stage_ms.find(stage);
+      const std::vector<double> none;
+      const auto& v = it == r->stage_ms.end() ? none : it->second;
+      md << " " << fmt(percentile(v, 0.5)) << " | " << fmt(percentile(v, 0.95)) << " |";
+    }
+    md << "\n";
+  }
+  // The peers' own stages, so that one sees where their time goes.
+  for (const Runner& r : runners) {
+    if (r.method.name == "clutterseg" || r.stage_order.empty()) continue;
+    md << "\n" << r.label << " per stage [ms], " << r.threads << " thread" << (r.threads == 1 ? "" : "s")
+       << ":\n\n| stage | median | p95 |\n|---|---:|---:|\n";
+    for (const auto& stage : r.stage_order) {
+      const auto& v = r.stage_ms.at(stage);
+      md << "| " << stage << " | " << fmt(percentile(v, 0.5)) << " | " << fmt(percentile(v, 0.95)) << " |\n";
+    }
+  }
+  return md.str();
+}
+
+int run(const BenchOptions& o) {
+  Params params = o.params.resolve();
+  const int threads = o.params.threads.value_or(1);  // the comparison runs on one core unless told
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  FrameSource source(o.dataset, o.camera);
+
+  std::vector<Runner> runners;
+  auto add = [&](const std::string& name, int t) {
+    Params p = params;
+    p.threads = t;
+    Runner r;
+    r.label = name;
+    r.threads = t;
+    r.method = make_method(name, p);
+    runners.push_back(std::move(r));
+  };
+  add("clutterseg", threads);
+  const int multi = threads == 1 ? cores : 1;  // the other thread count for the per-stage table
+  if (multi != threads) add("clutterseg", multi);
+  for (const auto& name : split_names(o.with)) {
+    if (name == "clutterseg") continue;
+    add(name, threads);
+  }
+
+  // All frames are loaded first so that disk reads are never timed.
+  std::vector<Frame> frames;
+  const size_t wanted = o.frames > 0 ? std::min<size_t>(o.frames, source.size()) : source.size();
+  for (size_t i = 0; i < source.size() && frames.size() < wanted; ++i) {
+    try {
+      frames.push_back(source.load(i));
+    } catch (const Error& e) {
+      report_error(e.what());
+    }
+  }
+  if (frames.empty()) throw Error(o.dataset + ": no frame could be loaded");
+
+  const int passes = o.repeat > 0 ? o.repeat : std::max(1, static_cast<int>((20 + frames.size() - 1) / frames.size()));
+  const int warmup = std::min<int>(std::max(o.warmup, 0), static_cast<int>(frames.size()));
+  Progress progress("bench", runners.size() * (warmup + passes * frames.size()));
+  // Methods are interleaved frame by frame so that all see the same load on a shared machine.
+  for (int i = 0; i < warmup; ++i)
+    for (Runner& r : runners) {
+      run_once(r, frames[i], false);
+      progress.step(r.label + " warm-up");
+    }
+  for (int pass = 0; pass < passes; ++pass)
+    for (const Frame& frame : frames)
+      for (Runner& r : runners) {
+        run_once(r, frame, true);
+        progress.step(r.label + " " + frame.name);
+      }
+  use_threads(params.threads);
+
+  const std::string md = report(o, runners, frames, passes, cores);
+  std::cout << md;
+  if (!o.out.empty()) write_text_atomic(o.out, md);
+  for (const Runner& r : runners)
+    if (r.failures) return 1;
+  return 0;
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+  auto opts = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand("bench", "time clutterseg and the PCL baselines on the same frames");
+  cmd->add_option("DATASET", opts->dataset, "dataset folder (camera.json + depth/), folder of PCDs, or one file")->required();
+  std::string names;
+  for (const auto& n : available_methods())
+    if (n != "clutterseg") names += (names.empty() ? "" : ",") + n;
+  cmd->add_option("--with", opts->with, "comma-separated peers to time beside clutterseg (this build: " +
+                                            (names.empty() ? std::string("none") : names) + ")");
+  cmd->add_option("--frames", opts->frames, "use only the first N frames (default all)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--warmup", opts->warmup, "untimed frames per method before timing (default 1)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--repeat", opts->repeat, "timed passes over the frames (default: enough for >= 20 timed frames)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--out", opts->out, "also write the markdown tables to this file");
+  opts->camera.add_to(*cmd);
+  opts->params.add_to(*cmd);  // --threads N: the comparison's thread count (bench default 1)
+  cmd->callback([opts] { throw CLI::RuntimeError(run(*opts)); });
+}
+
+}  // namespace clutterseg::app

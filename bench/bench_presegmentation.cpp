@@ -1,0 +1,104 @@
+// Pre-segmentation (paper a-c) per stage and in total, one core, on the osd-kinect frames at 640x480
+// and 320x240. Run: ./build/bench/bench_presegmentation --benchmark_repetitions=5
+//   --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <opencv2/imgproc.hpp>
+
+#include "clutterseg/edges.hpp"
+#include "clutterseg/io.hpp"
+#include "clutterseg/normals.hpp"
+#include "clutterseg/parallel.hpp"
+#include "clutterseg/patches.hpp"
+#include "clutterseg/smoothing.hpp"
+
+using namespace clutterseg;
+
+namespace {
+
+struct Input {
+  std::vector<cv::Mat> depth;  // CV_32F metres
+  Camera camera;
+};
+
+// The osd-kinect frames, at full size (scale 1) or subsampled by 2 (every other pixel, as a QVGA sensor).
+const Input& frames(int subsample) {
+  static std::map<int, Input> cache;
+  auto it = cache.find(subsample);
+  if (it != cache.end()) return it->second;
+  const std::filesystem::path set = std::filesystem::path(CLUTTERSEG_DATA_DIR) / "osd-kinect";
+  Input in;
+  in.camera = read_camera_json(set / "camera.json");
+  for (const auto& f : list_dataset(set)) {
+    cv::Mat d = depth_to_metres(read_depth_png(f.depth), in.camera);
+    if (subsample > 1) cv::resize(d, d, d.size() / subsample, 0, 0, cv::INTER_NEAREST);
+    in.depth.push_back(d);
+  }
+  in.camera.fx /= subsample;
+  in.camera.fy /= subsample;
+  in.camera.cx /= subsample;
+  in.camera.cy /= subsample;
+  in.camera.width /= subsample;
+  in.camera.height /= subsample;
+  return cache[subsample] = in;
+}
+
+// Runs `body` on every frame per iteration and reports time per frame.
+template <typename Body>
+void per_frame(benchmark::State& state, Body body) {
+  set_threads(1);
+  const Input& in = frames(static_cast<int>(state.range(0)));
+  for (auto _ : state)
+    for (const auto& d : in.depth) benchmark::DoNotOptimize(body(d, in.camera));
+  // Seconds of CPU per frame (shown with an SI prefix: 3.2m = 3.2 ms).
+  state.counters["per_frame"] = benchmark::Counter(static_cast<double>(state.iterations() * in.depth.size()),
+                                                   benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+const Params kParams;
+
+void Median(benchmark::State& s) { per_frame(s, [](const cv::Mat& d, const Camera&) { return median_depth(d); }); }
+
+void Temporal(benchmark::State& s) {
+  TemporalSmoother t;
+  per_frame(s, [&](const cv::Mat& d, const Camera&) { return t.push(d, kParams.smoothing); });
+}
+
+void PointCloud(benchmark::State& s) { per_frame(s, [](const cv::Mat& d, const Camera& c) { return depth_to_points(d, c); }); }
+
+void Normals(benchmark::State& s) {
+  per_frame(s, [](const cv::Mat& d, const Camera& c) {
+    const PixelScale px(c.fx, c.fy);
+    const int step = px.length(kParams.normals.step_px);
+    return compute_normals(d, c, step, px.odd(kParams.normals.smooth_ksize),
+                           relative_jump_limit(kParams.edges, step, c));
+  });
+}
+
+// Everything from raw metres to patches: a) median, temporal, points, normals; b) edges; c) patches.
+void Presegmentation(benchmark::State& s) {
+  TemporalSmoother t;
+  per_frame(s, [&](const cv::Mat& raw, const Camera& c) {
+    const PixelScale px(c.fx, c.fy);
+    const int step = px.length(kParams.normals.step_px), edge_step = px.length(kParams.edges.step_px);
+    const cv::Mat depth = t.push(median_depth(raw), kParams.smoothing);
+    const cv::Mat points = depth_to_points(depth, c);
+    const cv::Mat normals = compute_normals(depth, c, step, px.odd(kParams.normals.smooth_ksize),
+                                            relative_jump_limit(kParams.edges, step, c));
+    const cv::Mat edges = edge_mask(normal_edge_value(normals, edge_step), depth, kParams.edges.theta,
+                                    relative_jump_limit(kParams.edges, 1, c));
+    return extract_patches(edges, points, normals, kParams.patches, px.area(kParams.patches.min_size_px)).patches.size();
+  });
+}
+
+}  // namespace
+
+// Argument: subsampling (1 = 640x480, 2 = 320x240).
+BENCHMARK(Median)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(Temporal)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(PointCloud)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(Normals)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(Presegmentation)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,310 @@
+#include "clutterseg/curvature.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "clutterseg/occlusion.hpp"
+
+namespace clutterseg {
+
+namespace {
+
+// |correlation| between normal and position along the direction the normals turn in, above which
+// the sign decides convexity. An ideal cylinder or sphere gives exactly +-1; noise and a flat part
+// pull it towards 0.
+constexpr double kConvexityCorrelation = 0.5;
+constexpr int kMinPeakPoints = 3;            // fewest peak-bin points per patch for a line fit
+// Large patches are subsampled on a fixed pixel stride (deterministic) for the statistics below.
+constexpr size_t kConvexitySamples = 1024;  // pixels used at most for the moments of a patch
+constexpr size_t kBinnedSamples = 2048;     // pixels used at most for a patch's peak-bin points
+
+Eigen::Vector3f vec(const cv::Vec3f& v) { return {v[0], v[1], v[2]}; }
+
+// The bin of normal_histogram() (patches.cpp) that a normal falls into.
+int histogram_bin(const cv::Vec3f& n, int bins) {
+  auto bin = [bins](float c) { return std::clamp(static_cast<int>((c + 1.f) * 0.5f * bins), 0, bins - 1); };
+  return bin(n[1]) * bins + bin(n[0]);
+}
+
+int histogram_side(const std::vector<float>& histogram) {
+  return static_cast<int>(std::lround(std::sqrt(static_cast<double>(histogram.size()))));
+}
+
+cv::Rect grown(const cv::Rect& r, int by) { return {r.x - by, r.y - by, r.width + 2 * by, r.height + 2 * by}; }
+
+// Per label (index id - 1, only where `wanted`), the pixels with an 8-neighbour outside the label:
+// one pass over the image. The two closest pixels of two disjoint patches are boundary pixels: from
+// an interior pixel, a step towards the other patch stays inside and gets closer.
+std::vector<std::vector<cv::Point>> boundaries(const cv::Mat& labels, const std::vector<char>& wanted) {
+  std::vector<std::vector<cv::Point>> out(wanted.size());
+  const int max_id = static_cast<int>(wanted.size());
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* row = labels.ptr<int>(y);
+    const int* up = y > 0 ? labels.ptr<int>(y - 1) : nullptr;
+    const int* down = y + 1 < labels.rows ? labels.ptr<int>(y + 1) : nullptr;
+    for (int x = 0; x < labels.cols; ++x) {
+      const int id = row[x];
+      if (id <= 0 || id > max_id || !wanted[static_cast<size_t>(id - 1)]) continue;
+      bool edge = !up || !down || x == 0 || x + 1 == labels.cols;
+      for (int dx = -1; dx <= 1 && !edge; ++dx) edge = up[x + dx] != id || down[x + dx] != id || row[x + dx] != id;
+      if (edge) out[static_cast<size_t>(id - 1)].emplace_back(x, y);
+    }
+  }
+  return out;
+}
+
+// Some pixel of a lies within `gap` pixels of some pixel of b (boundaries of both), via a grid of
+// gap-sized cells over b's boundary: O(|boundary a| + |boundary b|).
+bool within_gap(const std::vector<cv::Point>& a, const std::vector<cv::Point>& b, int gap, cv::Size image) {
+  if (a.empty() || b.empty()) return false;
+  const int cols = image.width / gap + 1, rows = image.height / gap + 1;
+  std::vector<int> start(static_cast<size_t>(cols * rows) + 1, 0);
+  auto cell = [&](const cv::Point& p) { return (p.y / gap) * cols + p.x / gap; };
+  for (const auto& p : b) ++start[static_cast<size_t>(cell(p)) + 1];
+  for (size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<cv::Point> sorted(b.size());
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (const auto& p : b) sorted[static_cast<size_t>(fill[static_cast<size_t>(cell(p))]++)] = p;
+  const int gap2 = gap * gap;
+  for (const auto& p : a) {
+    const int cx = p.x / gap, cy = p.y / gap;
+    for (int y = std::max(0, cy - 1); y <= std::min(rows - 1, cy + 1); ++y)
+      for (int x = std::max(0, cx - 1); x <= std::min(cols - 1, cx + 1); ++x)
+        for (int k = start[static_cast<size_t>(y * cols + x)]; k < start[static_cast<size_t>(y * cols + x) + 1]; ++k) {
+          const cv::Point d = sorted[static_cast<size_t>(k)] - p;
+          if (d.x * d.x + d.y * d.y <= gap2) return true;
+        }
+  }
+  return false;
+}
+
+// A patch's pixels (at most kBinnedSamples of them, on a fixed stride) grouped by the histogram bin
+// of their normal (counting sort), built once per patch so each pair only reads the bin it needs.
+struct BinnedPixels {
+  std::vector<int> start;   // bins*bins + 1 offsets into `pixels`
+  std::vector<int> pixels;  // valid pixels, ordered by bin
+
+  BinnedPixels(const Patch& patch, int bins, const cv::Mat& points, const cv::Mat& normals) {
+    const auto* pts = points.ptr<cv::Vec3f>();
+    const auto* nrm = normals.ptr<cv::Vec3f>();
+    const size_t stride = std::max<size_t>(1, patch.pixels.size() / kBinnedSamples);
+    std::vector<int> sampled, bin_of;
+    start.assign(static_cast<size_t>(bins * bins) + 1, 0);
+    for (size_t k = 0; k < patch.pixels.size(); k += stride) {
+      const int i = patch.pixels[k];
+      if (!(pts[i][2] > 0)) continue;
+      sampled.push_back(i);
+      bin_of.push_back(histogram_bin(nrm[i], bins));
+      ++start[static_cast<size_t>(bin_of.back()) + 1];
+    }
+    for (size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    pixels.resize(sampled.size());
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (size_t k = 0; k < sampled.size(); ++k) pixels[static_cast<size_t>(fill[static_cast<size_t>(bin_of[k])]++)] = sampled[k];
+  }
+
+  std::vector<Eigen::Vector3f> points_in(int bin, const cv::Mat& points) const {
+    const auto* pts = points.ptr<cv::Vec3f>();
+    std::vector<Eigen::Vector3f> out;
+    for (int k = start[static_cast<size_t>(bin)]; k < start[static_cast<size_t>(bin) + 1]; ++k)
+      out.push_back(vec(pts[pixels[static_cast<size_t>(k)]]));
+    return out;
+  }
+};
+
+struct Line {
+  Eigen::Vector3f point, direction;
+  float distance(const Eigen::Vector3f& x) const { return (x - point - (x - point).dot(direction) * direction).norm(); }
+  float position(const Eigen::Vector3f& x) const { return (x - point).dot(direction); }
+};
+
+Line fit_line(const std::vector<Eigen::Vector3f>& a, const std::vector<Eigen::Vector3f>& b) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto* set : {&a, &b})
+    for (const auto& p : *set) mean += p.cast<double>();
+  mean /= static_cast<double>(a.size() + b.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto* set : {&a, &b})
+    for (const auto& p : *set) {
+      const Eigen::Vector3d d = p.cast<double>() - mean;
+      cov += d * d.transpose();
+    }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  return {mean.cast<float>(), eig.eigenvectors().col(2).normalized().cast<float>()};
+}
+
+float rms_distance(const Line& line, const std::vector<Eigen::Vector3f>& set) {
+  double sum = 0;
+  for (const auto& p : set) sum += static_cast<double>(line.distance(p)) * line.distance(p);
+  return static_cast<float>(std::sqrt(sum / static_cast<double>(set.size())));
+}
+
+// Paper h), occluded curved object: the points of the bin both histograms share most (for a
+// cylinder: a generator line on each part) lie on one 3D line, and the stretch of that line between
+// the two parts is hidden by something in front, not open to the background.
+bool aligned_and_occluded(const Patch& a, const BinnedPixels& binned_a, const Patch& b, const BinnedPixels& binned_b,
+                          const cv::Mat& points, const Camera& camera, const Params& params) {
+  int peak = 0;
+  float best = -1;
+  for (size_t k = 0; k < a.histogram.size(); ++k) {
+    const float shared = std::min(a.histogram[k], b.histogram[k]);
+    if (shared > best) { best = shared; peak = static_cast<int>(k); }
+  }
+  const auto pa = binned_a.points_in(peak, points), pb = binned_b.points_in(peak, points);
+  if (static_cast<int>(pa.size()) < kMinPeakPoints || static_cast<int>(pb.size()) < kMinPeakPoints) return false;
+  const Line line = fit_line(pa, pb);
+  // Each part must follow the line, so a large part cannot hide a small one that is off the line.
+  const auto fit = static_cast<float>(params.curvature.line_fit);
+  if (rms_distance(line, pa) > fit || rms_distance(line, pb) > fit) return false;
+
+  float a_lo = INFINITY, a_hi = -INFINITY, b_lo = INFINITY, b_hi = -INFINITY;
+  for (const auto& p : pa) { const float t = line.position(p); a_lo = std::min(a_lo, t); a_hi = std::max(a_hi, t); }
+  for (const auto& p : pb) { const float t = line.position(p); b_lo = std::min(b_lo, t); b_hi = std::max(b_hi, t); }
+  float from, to;
+  if (a_hi < b_lo) { from = a_hi; to = b_lo; }
+  else if (b_hi < a_lo) { from = b_hi; to = a_lo; }
+  else return false;  // side by side along the line: nothing between them to be an occluder
+  const Eigen::Vector3f start = line.point + from * line.direction, end = line.point + to * line.direction;
+  return behind_fraction(start, end, points, camera, params.coplanarity.behind_tolerance) <=
+         params.coplanarity.behind_fraction;
+}
+
+}  // namespace
+
+double histogram_similarity(const std::vector<float>& a, const std::vector<float>& b) {
+  if (a.size() != b.size()) throw Error("histogram_similarity: histograms differ in size");
+  double s = 0;
+  for (size_t k = 0; k < a.size(); ++k) s += std::min(a[k], b[k]);
+  return s;
+}
+
+int convexity(const Patch& patch, const cv::Mat& points, const cv::Mat& normals, int bins) {
+  // Physically: on a convex surface the (outward, camera-facing) normal turns the way one walks,
+  // dn = S dp with a positive shape operator S; on a concave one it turns against. We find the
+  // direction e in which the normals vary most (the major axis of the histogram blob, paper Eq. 4)
+  // and correlate n.e with p.e over the patch: the sign is the sign of the curvature along e.
+  // One pass of first and second moments; large patches are subsampled on a fixed stride.
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const auto* nrm = normals.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, patch.pixels.size() / kConvexitySamples);
+  Eigen::Vector3d sn = Eigen::Vector3d::Zero(), sp = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d snn = Eigen::Matrix3d::Zero(), snp = Eigen::Matrix3d::Zero(), spp = Eigen::Matrix3d::Zero();
+  double count = 0;
+  for (size_t k = 0; k < patch.pixels.size(); k += stride) {
+    const int i = patch.pixels[k];
+    if (!(pts[i][2] > 0) || (nrm[i][0] == 0 && nrm[i][1] == 0 && nrm[i][2] == 0)) continue;
+    const Eigen::Vector3d n = vec(nrm[i]).cast<double>(), p = vec(pts[i]).cast<double>();
+    sn += n; sp += p;
+    snn.noalias() += n * n.transpose();
+    snp.noalias() += n * p.transpose();
+    spp.noalias() += p * p.transpose();
+    ++count;
+  }
+  if (count < 10) return 0;
+  const Eigen::Vector3d n_mean = sn / count, p_mean = sp / count;
+  const Eigen::Matrix3d n_cov = snn / count - n_mean * n_mean.transpose();
+  const Eigen::Matrix3d np_cov = snp / count - n_mean * p_mean.transpose();
+  const Eigen::Matrix3d p_cov = spp / count - p_mean * p_mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(n_cov);
+  const Eigen::Vector3d e = eig.eigenvectors().col(2);
+  // Normals that vary by less than a histogram bin along e: no curvature to judge.
+  if (2 * std::sqrt(std::max(0.0, eig.eigenvalues()(2))) < 2.0 / std::max(1, bins)) return 0;
+  const double var_n = e.dot(n_cov * e), var_p = e.dot(p_cov * e), cov_np = e.dot(np_cov * e);
+  if (var_n <= 0 || var_p <= 0) return 0;
+  const double correlation = cov_np / std::sqrt(var_n * var_p);
+  return correlation > kConvexityCorrelation ? 1 : correlation < -kConvexityCorrelation ? -1 : 0;
+}
+
+std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, const std::vector<PatchPair>& linked,
+                                           const cv::Mat& assigned_labels, const cv::Mat& points,
+                                           const cv::Mat& normals, const Camera& camera, const Params& params) {
+  std::vector<CurvatureLink> out;
+  const auto& p = params.curvature;
+  if (!p.enabled || (!p.open_objects && !p.occluded)) return out;
+  if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || normals.type() != CV_32FC3 ||
+      assigned_labels.size() != points.size() || normals.size() != points.size())
+    throw Error("curvature_links: labels (CV_32S), points and normals (CV_32FC3) must be images of one size");
+  std::vector<PatchPair> known = linked;
+  for (auto& pair : known)
+    if (pair.first > pair.second) std::swap(pair.first, pair.second);
+  std::sort(known.begin(), known.end());
+
+  std::vector<int> curved;
+  for (size_t i = 0; i < patches.size(); ++i)
+    if (patches[i].curved && !patches[i].pixels.empty()) curved.push_back(static_cast<int>(i));
+
+  // Similar histograms first (121 bins per pair); the pixel work only for the similar pairs.
+  std::vector<PatchPair> similar;
+  for (size_t x = 0; x < curved.size(); ++x)
+    for (size_t y = x + 1; y < curved.size(); ++y) {
+      const int i = curved[x], j = curved[y];
+      if (std::binary_search(known.begin(), known.end(), PatchPair(i, j))) continue;
+      const auto& a = patches[static_cast<size_t>(i)];
+      const auto& b = patches[static_cast<size_t>(j)];
+      if (a.histogram.size() != b.histogram.size() || a.histogram.empty()) continue;
+      if (histogram_similarity(a.histogram, b.histogram) > p.theta_h) similar.emplace_back(i, j);
+    }
+  if (similar.empty()) return out;
+
+  const PixelScale px(camera.fx, camera.fy);
+  const int gap = px.length(p.neighbour_gap_px);
+  // Edge pixels join a patch only within the adjacency radius of its core pixels (paper d), so the
+  // core box grown by that radius holds all of the patch's assigned pixels.
+  const int assign_radius = px.length(params.adjacency.radius_px);
+  auto box_of = [&](const Patch& patch) { return grown(patch.bbox, assign_radius); };
+  std::vector<int> convex(patches.size(), 2);  // 2 = not computed yet
+  auto convexity_of = [&](int i) {
+    auto& c = convex[static_cast<size_t>(i)];
+    if (c == 2) c = convexity(patches[static_cast<size_t>(i)], points, normals, histogram_side(patches[static_cast<size_t>(i)].histogram));
+    return c;
+  };
+  // Boundaries of all similar patches in one pass over the image, the first time a pair needs them.
+  std::vector<std::vector<cv::Point>> boundary_by_id;
+  auto boundary_of = [&](int i) -> const std::vector<cv::Point>& {
+    if (boundary_by_id.empty()) {
+      std::vector<char> wanted;
+      for (const auto& [x, y] : similar)
+        for (const int k : {x, y}) {
+          const int id = patches[static_cast<size_t>(k)].id;
+          if (id > static_cast<int>(wanted.size())) wanted.resize(static_cast<size_t>(id), 0);
+          if (id > 0) wanted[static_cast<size_t>(id - 1)] = 1;
+        }
+      boundary_by_id = boundaries(assigned_labels, wanted);
+    }
+    return boundary_by_id[static_cast<size_t>(patches[static_cast<size_t>(i)].id - 1)];
+  };
+  auto neighbours = [&](int i, int j) {
+    const auto& a = patches[static_cast<size_t>(i)];
+    const auto& b = patches[static_cast<size_t>(j)];
+    if (a.id <= 0 || b.id <= 0 || (grown(box_of(a), gap) & box_of(b)).area() == 0) return false;
+    return within_gap(boundary_of(i), boundary_of(j), gap, assigned_labels.size());
+  };
+  std::vector<std::unique_ptr<BinnedPixels>> binned(patches.size());
+  auto binned_of = [&](int i) -> const BinnedPixels& {
+    auto& b = binned[static_cast<size_t>(i)];
+    const Patch& patch = patches[static_cast<size_t>(i)];
+    if (!b) b = std::make_unique<BinnedPixels>(patch, histogram_side(patch.histogram), points, normals);
+    return *b;
+  };
+  // Cheapest test first per rule; the image-neighbour test (which decides between the two rules)
+  // only for pairs that one rule would link.
+  for (const auto& [i, j] : similar) {
+    const auto& a = patches[static_cast<size_t>(i)];
+    const auto& b = patches[static_cast<size_t>(j)];
+    // Open object: the outer (convex) and inner (concave) wall of a cup or bowl meet at the rim.
+    if (p.open_objects && convexity_of(i) * convexity_of(j) == -1) {
+      if (neighbours(i, j)) {
+        out.push_back({{i, j}, Cue::CurvatureOpen});
+        continue;
+      }
+    }
+    // Occluded curved object: aligned, with an occluder between, and not image neighbours.
+    if (p.occluded && aligned_and_occluded(a, binned_of(i), b, binned_of(j), points, camera, params) && !neighbours(i, j))
+      out.push_back({{i, j}, Cue::CurvatureOccluded});
+  }
+  return out;
+}
+
+}  // namespace clutterseg

@@ -1,0 +1,50 @@
+// Finding the patches of a segmented test scene by its ground-truth labels.
+#pragma once
+
+#include <vector>
+
+#include "clutterseg/segmenter.hpp"
+#include "scenes.hpp"
+
+namespace clutterseg::scenes {
+
+struct Segmented {
+  synth::Rendering truth;
+  Result result;
+};
+
+inline Segmented segment_scene(const TestScene& scene, const Params& params = {}) {
+  Segmented s{scene.render(), {}};
+  s.result = segment(s.truth.depth, scene.camera, params);
+  return s;
+}
+
+// Indices of the patches lying entirely on ground-truth object `label`, in patch order.
+inline std::vector<int> patches_on(const Segmented& s, int label) {
+  std::vector<int> out;
+  const int* truth = s.truth.labels.ptr<int>();
+  for (size_t i = 0; i < s.result.patches.size(); ++i) {
+    const auto& pixels = s.result.patches[i].pixels;
+    bool pure = !pixels.empty();
+    for (int k : pixels) pure = pure && truth[k] == label;
+    if (pure) out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+// Among `candidates`, those whose mean normal is within ~25 degrees of `direction` (camera frame).
+inline std::vector<int> facing(const Segmented& s, const std::vector<int>& candidates, const Eigen::Vector3f& direction) {
+  std::vector<int> out;
+  for (int i : candidates)
+    if (s.result.patches[static_cast<size_t>(i)].mean_normal.dot(direction.normalized()) > 0.9f) out.push_back(i);
+  return out;
+}
+
+// Camera-frame direction of a world-frame direction.
+inline Eigen::Vector3f camera_direction(const TestScene& scene, const Eigen::Vector3d& world) {
+  return (scene.world_to_camera.linear() * world).cast<float>();
+}
+
+inline Eigen::Vector3f direction_up(const TestScene& scene) { return camera_direction(scene, Eigen::Vector3d::UnitZ()); }
+
+}  // namespace clutterseg::scenes

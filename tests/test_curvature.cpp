@@ -1,0 +1,162 @@
+// Paper h): curved patches linked by their normal histograms: the inner and outer wall of a cup (open
+// object) and the two parts of a lying cylinder cut by an occluder (occluded curved object).
+#include <gtest/gtest.h>
+
+#include "clutterseg/curvature.hpp"
+#include "scene_patches.hpp"
+
+using namespace clutterseg;
+using namespace clutterseg::scenes;
+
+namespace {
+
+const Patch& patch(const Segmented& s, int i) { return s.result.patches[static_cast<size_t>(i)]; }
+
+std::vector<CurvatureLink> links_of(const Segmented& s, const TestScene& scene, const Params& params = {}) {
+  const Result& r = s.result;
+  return curvature_links(r.patches, {}, r.core_patch_labels, r.points, r.normals, scene.camera, params);
+}
+
+// A hand-made patch on a cylinder of radius r about the camera's y axis at depth z0 (+1: the outside
+// seen from outside; -1: the inside seen from inside), 60 degrees of arc in view.
+struct Synthetic {
+  cv::Mat points, normals;
+  Patch patch;
+};
+Synthetic cylinder_patch(int side) {
+  const int w = 60, h = 20;
+  Synthetic s{cv::Mat(h, w, CV_32FC3), cv::Mat(h, w, CV_32FC3), {}};
+  const float r = 0.05f, z0 = 1.f;
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const float a = (static_cast<float>(u) / (w - 1) - 0.5f) * static_cast<float>(M_PI / 3);
+      // Outside: surface bulges towards the camera, normal points out of the axis (towards -z).
+      // Inside: surface bends away, normal points into the axis (still towards the camera).
+      const float x = r * std::sin(a), z = z0 - static_cast<float>(side) * r * std::cos(a);
+      const Eigen::Vector3f n(static_cast<float>(side) * std::sin(a), 0, -std::cos(a));
+      s.points.at<cv::Vec3f>(v, u) = {x, 0.002f * static_cast<float>(v), z};
+      s.normals.at<cv::Vec3f>(v, u) = {n.x(), n.y(), n.z()};
+      s.patch.pixels.push_back(v * w + u);
+    }
+  return s;
+}
+
+}  // namespace
+
+TEST(Histogram, SimilarityIsTheSharedMass) {
+  const std::vector<float> a = {0.5f, 0.5f, 0, 0}, b = {0, 0.25f, 0.75f, 0}, c = {0, 0, 0, 1};
+  EXPECT_DOUBLE_EQ(histogram_similarity(a, a), 1.0);
+  EXPECT_DOUBLE_EQ(histogram_similarity(a, b), 0.25);
+  EXPECT_DOUBLE_EQ(histogram_similarity(b, a), 0.25);
+  EXPECT_DOUBLE_EQ(histogram_similarity(a, c), 0.0);
+  EXPECT_THROW(histogram_similarity(a, {1.f}), Error);
+}
+
+TEST(Convexity, OutsideOfACylinderIsConvexItsInsideConcave) {
+  const Synthetic outside = cylinder_patch(+1), inside = cylinder_patch(-1);
+  EXPECT_EQ(convexity(outside.patch, outside.points, outside.normals, 11), 1);
+  EXPECT_EQ(convexity(inside.patch, inside.points, inside.normals, 11), -1);
+  // A plane: the normals do not turn, nothing to decide.
+  Synthetic flat = cylinder_patch(+1);
+  flat.normals.setTo(cv::Scalar(0, 0, -1));
+  EXPECT_EQ(convexity(flat.patch, flat.points, flat.normals, 11), 0);
+}
+
+TEST(Convexity, CupOuterWallConvexInnerWallConcave) {
+  const TestScene scene = cup();
+  const Segmented s = segment_scene(scene);
+  const auto walls = patches_on(s, 1);
+  ASSERT_EQ(walls.size(), 2u);
+  // The outer wall faces the camera in front of the cup's axis, the inner wall is its far side.
+  const Eigen::Isometry3f to_world = scene.world_to_camera.inverse().cast<float>();
+  const bool first_outer = (to_world * patch(s, walls[0]).centroid).y() < (to_world * patch(s, walls[1]).centroid).y();
+  const Patch& outer = patch(s, first_outer ? walls[0] : walls[1]);
+  const Patch& inner = patch(s, first_outer ? walls[1] : walls[0]);
+  ASSERT_TRUE(outer.curved && inner.curved);
+  // SPEC: the outer wall's lower edge lies lower in the image than the inner wall's.
+  EXPECT_GT(outer.bbox.br().y, inner.bbox.br().y);
+  EXPECT_EQ(convexity(outer, s.result.points, s.result.normals, 11), 1);
+  EXPECT_EQ(convexity(inner, s.result.points, s.result.normals, 11), -1);
+}
+
+TEST(Curvature, OpenObjectRuleLinksTheCupWalls) {
+  const TestScene scene = cup();
+  const Segmented s = segment_scene(scene);
+  const auto walls = patches_on(s, 1);
+  ASSERT_EQ(walls.size(), 2u);
+  const auto links = links_of(s, scene);
+  ASSERT_EQ(links.size(), 1u);
+  EXPECT_EQ(links[0].pair, PatchPair(std::min(walls[0], walls[1]), std::max(walls[0], walls[1])));
+  EXPECT_EQ(links[0].cue, Cue::CurvatureOpen);
+  Params off;
+  off.curvature.open_objects = false;
+  EXPECT_TRUE(links_of(s, scene, off).empty());
+  // Already linked (e.g. by adjacency): not linked twice.
+  const Result& r = s.result;
+  EXPECT_TRUE(curvature_links(r.patches, {links[0].pair}, r.core_patch_labels, r.points, r.normals, scene.camera, {}).empty());
+}
+
+TEST(Curvature, OccludedRuleLinksTheCylinderPartsOnly) {
+  // Paper Fig. 6: the two parts of the lying cylinder, a standing cylinder and a sphere.
+  const TestScene scene = curved_objects();
+  const Segmented s = segment_scene(scene);
+  const auto parts = patches_on(s, 1), sphere = patches_on(s, 4);
+  // The standing cylinder shows a flat cap and a curved side, split by the crease between them.
+  std::vector<int> standing;
+  for (int i : patches_on(s, 3))
+    if (patch(s, i).curved) standing.push_back(i);
+  ASSERT_EQ(parts.size(), 2u);
+  ASSERT_EQ(standing.size(), 1u);
+  ASSERT_EQ(sphere.size(), 1u);
+  ASSERT_TRUE(patch(s, standing[0]).curved && patch(s, sphere[0]).curved);
+  const auto links = links_of(s, scene);
+  ASSERT_EQ(links.size(), 1u);
+  EXPECT_EQ(links[0].pair, PatchPair(std::min(parts[0], parts[1]), std::max(parts[0], parts[1])));
+  EXPECT_EQ(links[0].cue, Cue::CurvatureOccluded);
+  Params off;
+  off.curvature.occluded = false;
+  EXPECT_TRUE(links_of(s, scene, off).empty());
+  off = {};
+  off.curvature.enabled = false;
+  EXPECT_TRUE(links_of(s, scene, off).empty());
+}
+
+TEST(Curvature, AlignedCylindersWithTableBetweenAreNotLinked) {
+  // Same shape, same axis, but the gap shows bare table: the occlusion check must refuse.
+  const TestScene scene = coaxial_cylinders();
+  const Segmented s = segment_scene(scene);
+  const auto a = patches_on(s, 1), b = patches_on(s, 2);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_GT(histogram_similarity(patch(s, a[0]).histogram, patch(s, b[0]).histogram), 0.9);
+  EXPECT_TRUE(links_of(s, scene).empty());
+  // It is the occlusion check that refuses: accepting any share of samples behind links them.
+  Params blind;
+  blind.coplanarity.behind_fraction = 1.0;
+  EXPECT_EQ(links_of(s, scene, blind).size(), 1u);
+  // The similarity threshold alone: at theta_h = 1 even the occluded cylinder's parts stay apart.
+  Params strict;
+  strict.curvature.theta_h = 1.0;
+  EXPECT_TRUE(links_of(segment_scene(curved_objects()), curved_objects(), strict).empty());
+}
+
+TEST(Curvature, SameDecisionsAtVga) {
+  // Every threshold is physical or scaled with the resolution: 640x480 decides as 320x240 does.
+  auto at_vga = [](TestScene scene) {
+    scene.camera = synth::default_camera(640, 480);
+    return scene;
+  };
+  const TestScene cup_scene = at_vga(cup()), curved = at_vga(curved_objects()), coaxial = at_vga(coaxial_cylinders());
+  const Segmented c = segment_scene(cup_scene);
+  const auto cup_links = links_of(c, cup_scene);
+  ASSERT_EQ(cup_links.size(), 1u);
+  EXPECT_EQ(cup_links[0].cue, Cue::CurvatureOpen);
+  const Segmented o = segment_scene(curved);
+  const auto parts = patches_on(o, 1);
+  const auto links = links_of(o, curved);
+  ASSERT_EQ(parts.size(), 2u);
+  ASSERT_EQ(links.size(), 1u);
+  EXPECT_EQ(links[0].pair, PatchPair(std::min(parts[0], parts[1]), std::max(parts[0], parts[1])));
+  EXPECT_EQ(links[0].cue, Cue::CurvatureOccluded);
+  EXPECT_TRUE(links_of(segment_scene(coaxial), coaxial).empty());
+}
