@@ -8,8 +8,11 @@
 #include <numeric>
 
 #include "clutterseg/adjacency.hpp"
+#include "clutterseg/coplanarity.hpp"
+#include "clutterseg/curvature.hpp"
 #include "clutterseg/cutfree.hpp"
 #include "clutterseg/edges.hpp"
+#include "clutterseg/graph_cut.hpp"
 #include "clutterseg/normals.hpp"
 #include "clutterseg/objects.hpp"
 #include "clutterseg/parallel.hpp"
@@ -36,37 +39,14 @@ class Stopwatch {
   Clock::time_point start_, last_;
 };
 
-// Stand-in for f-i until the graph cut is merged: objects = connected components of the links (the
-// paper's "adjacency + cut-free only" comparison). Fills the weighted graph (1/deg, symmetrised).
-struct Components {
-  std::vector<int> object_of_patch;
-  std::vector<float> cut_cost;  // +inf for one patch; 0 (unknown) for several until the graph cut
-};
-Components linked_components(int num_patches, const std::vector<PatchPair>& links, std::vector<GraphEdge>& graph) {
-  std::vector<int> parent(static_cast<size_t>(num_patches));
-  std::iota(parent.begin(), parent.end(), 0);
-  auto root = [&](int x) { while (parent[static_cast<size_t>(x)] != x) x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])]; return x; };
-  std::vector<int> degree(static_cast<size_t>(num_patches), 0);
-  for (const auto& [a, b] : links) {
-    parent[static_cast<size_t>(root(a))] = root(b);
-    ++degree[static_cast<size_t>(a)];
-    ++degree[static_cast<size_t>(b)];
-  }
-  for (const auto& [a, b] : links)
-    graph.push_back({a, b, Cue::Adjacent, 0.5f / static_cast<float>(degree[static_cast<size_t>(a)]) + 0.5f / static_cast<float>(degree[static_cast<size_t>(b)])});
-  std::vector<int> object_of_root(static_cast<size_t>(num_patches), -1);
-  Components c;
-  for (int p = 0; p < num_patches; ++p) {
-    int& o = object_of_root[static_cast<size_t>(root(p))];
-    if (o < 0) {
-      o = static_cast<int>(c.cut_cost.size());
-      c.cut_cost.push_back(std::numeric_limits<float>::infinity());
-    } else {
-      c.cut_cost[static_cast<size_t>(o)] = 0.f;
-    }
-    c.object_of_patch.push_back(o);
-  }
-  return c;
+// The patch graph of paper i): every link with its cue, weighted 1/deg and symmetrised.
+std::vector<GraphEdge> patch_graph(int num_patches, const std::vector<PatchPair>& adjacent,
+                                   const std::vector<PatchPair>& coplanar, const std::vector<CurvatureLink>& curved) {
+  std::vector<GraphEdge> links;
+  for (const auto& [a, b] : adjacent) links.push_back({a, b, Cue::Adjacent, 0});
+  for (const auto& [a, b] : coplanar) links.push_back({a, b, Cue::Coplanar, 0});
+  for (const auto& c : curved) links.push_back({c.pair.first, c.pair.second, c.cue, 0});
+  return weight_graph(num_patches, std::move(links));
 }
 
 cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
@@ -117,13 +97,22 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   const std::vector<PatchPair> links = p.cutfree.enabled                                  // e) cut-free
       ? cut_free_pairs(assignment.adjacent, r.patches, r.points, p.cutfree, p.seed) : assignment.adjacent;
   watch.mark("cutfree");
-  const Components parts = linked_components(num_patches, links, r.graph);               // f-i) stand-in
-  watch.mark("graph");
-  r.object_labels = assign_remaining(r.patch_labels, parts.object_of_patch,                      // j) remaining
+  std::vector<PatchPair> linked = links;
+  const std::vector<PatchPair> coplanar = p.coplanarity.enabled                         // f/g) co-planarity
+      ? coplanar_pairs(r.patches, linked, r.points, camera, p.coplanarity, p.seed) : std::vector<PatchPair>{};
+  linked.insert(linked.end(), coplanar.begin(), coplanar.end());
+  watch.mark("coplanarity");
+  const std::vector<CurvatureLink> curved = p.curvature.enabled                          // h) curvature
+      ? curvature_links(r.patches, linked, r.patch_labels, r.points, r.normals, camera, p) : std::vector<CurvatureLink>{};
+  watch.mark("curvature");
+  r.graph = patch_graph(num_patches, links, coplanar, curved);                           // i) graph cut
+  const Partition parts = cut_graph(num_patches, r.graph, p.graph.theta_c);
+  watch.mark("graph_cut");
+  r.object_labels = assign_remaining(r.patch_labels, parts.object_of_node,                       // j) remaining
                                      static_cast<int>(parts.cut_cost.size()), r.points, p.remaining,
                                      px.area(p.remaining.tiny_px), p.seed);
   watch.mark("remaining");
-  r.objects = describe_objects(r.object_labels, r.points, parts.object_of_patch, parts.cut_cost, camera);  // objects
+  r.objects = describe_objects(r.object_labels, r.points, parts.object_of_node, parts.cut_cost, camera);  // objects
   r.support_plane = find_support(r.objects, r.patches, r.object_labels, r.points, p.support);   // table, walls
   if (r.support_plane)                                                           // objects merged into it
     split_support(r.object_labels, r.objects, *r.support_plane, r.points, p.support, px.area(p.patches.min_size_px), camera);
