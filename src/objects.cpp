@@ -1,6 +1,435 @@
+// Per-object outputs: statistics, the support plane (table) and the objects-only view.
 #include "clutterseg/objects.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+
 namespace clutterseg {
+
+namespace {
+
+bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
+
+Eigen::Vector3d to_eigen(const cv::Vec3f& p) { return {p[0], p[1], p[2]}; }
+
+// Least-squares plane of a pixel list (at most ~3000 of them used), normal facing the camera.
+bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& plane) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / 3000);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  int n = 0;
+  for (size_t k = 0; k < pixels.size(); k += stride) {
+    if (!valid_point(pts[pixels[k]])) continue;
+    const Eigen::Vector3d q = to_eigen(pts[pixels[k]]);
+    sum += q;
+    outer += q * q.transpose();
+    ++n;
+  }
+  if (n < 10) return false;
+  const Eigen::Vector3d mean = sum / n;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / n - mean * mean.transpose());
+  if (eig.eigenvalues()(1) < 1e-8) return false;
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  if (normal.dot(mean) > 0) normal = -normal;
+  plane.normal = normal.cast<float>();
+  plane.offset = static_cast<float>(-normal.dot(mean));
+  return true;
+}
+
+// The visible region of a support candidate: convex hull of its points projected into the plane,
+// grown by a margin and rasterised at 1 cm so that the test per point is a lookup.
+struct PlaneRegion {
+  Plane plane;
+  Eigen::Vector3f u, v;   // orthonormal basis of the plane
+  cv::Point2f origin;     // plane coordinates [m] of cell (0, 0)
+  cv::Mat cells;          // CV_8U, 255 = over the region
+  static constexpr float kCell = 0.01f;  // [m]
+  bool over(const Eigen::Vector3f& q) const {
+    const int cx = static_cast<int>(std::floor((u.dot(q) - origin.x) / kCell));
+    const int cy = static_cast<int>(std::floor((v.dot(q) - origin.y) / kCell));
+    return cx >= 0 && cy >= 0 && cx < cells.cols && cy < cells.rows && cells.at<uchar>(cy, cx);
+  }
+};
+
+PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin) {
+  PlaneRegion r;
+  r.plane = plane;
+  r.u = plane.normal.unitOrthogonal();
+  r.v = plane.normal.cross(r.u);
+  const auto* pts = points.ptr<cv::Vec3f>();
+  std::vector<cv::Point2f> projected;
+  const size_t stride = std::max<size_t>(1, pixels.size() / 4000);
+  for (size_t k = 0; k < pixels.size(); k += stride)
+    if (valid_point(pts[pixels[k]])) {
+      const Eigen::Vector3f q = to_eigen(pts[pixels[k]]).cast<float>();
+      projected.emplace_back(r.u.dot(q), r.v.dot(q));
+    }
+  if (projected.size() < 3) return r;
+  std::vector<cv::Point2f> hull;
+  cv::convexHull(projected, hull);
+  cv::Rect2f box(hull[0], hull[0]);
+  for (const auto& h : hull) {
+    const float x1 = std::max(box.x + box.width, h.x), y1 = std::max(box.y + box.height, h.y);
+    box.x = std::min(box.x, h.x);
+    box.y = std::min(box.y, h.y);
+    box.width = x1 - box.x;
+    box.height = y1 - box.y;
+  }
+  const int pad = static_cast<int>(std::ceil(margin / PlaneRegion::kCell)) + 1;
+  r.origin = {box.x - pad * PlaneRegion::kCell, box.y - pad * PlaneRegion::kCell};
+  // Bounded: a region larger than 20 m x 20 m is cut (no depth sensor sees one).
+  const int cols = std::min(2000, static_cast<int>(std::ceil(box.width / PlaneRegion::kCell)) + 2 * pad + 1);
+  const int rows = std::min(2000, static_cast<int>(std::ceil(box.height / PlaneRegion::kCell)) + 2 * pad + 1);
+  r.cells = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  std::vector<cv::Point> poly;
+  for (const auto& h : hull)
+    poly.emplace_back(static_cast<int>(std::lround((h.x - r.origin.x) / PlaneRegion::kCell)),
+                      static_cast<int>(std::lround((h.y - r.origin.y) / PlaneRegion::kCell)));
+  cv::fillConvexPoly(r.cells, poly, cv::Scalar(255));
+  if (pad > 1) cv::dilate(r.cells, r.cells, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * pad - 1, 2 * pad - 1}));
+  return r;
+}
+
+// Share of a patch's points within `band` of its least-squares plane (flatness that does not depend
+// on the normal histogram, which noise spreads on large, far surfaces).
+double inlier_share(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double band) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
+  int in = 0, n = 0;
+  for (size_t k = 0; k < pixels.size(); k += stride) {
+    if (!valid_point(pts[pixels[k]])) continue;
+    ++n;
+    in += std::abs(plane.distance(to_eigen(pts[pixels[k]]).cast<float>())) <= band;
+  }
+  return n ? static_cast<double>(in) / n : 0.0;
+}
+
+// Dominant plane of a patch: RANSAC over its points (a table patch may hold the foot of an object that
+// the edges did not separate), refined by least squares on the inliers. Deterministic: the draws are
+// seeded by the patch size. Returns the inlier share.
+double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, double band, Plane& plane) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  std::vector<int> sample;
+  const size_t stride = std::max<size_t>(1, pixels.size() / 1000);
+  for (size_t k = 0; k < pixels.size(); k += stride)
+    if (valid_point(pts[pixels[k]])) sample.push_back(pixels[k]);
+  if (sample.size() < 10) return 0;
+  std::uint64_t state = 0x9e3779b97f4a7c15ULL ^ pixels.size();
+  auto next = [&] {  // xorshift64: a small, portable, seeded generator
+    state ^= state << 13; state ^= state >> 7; state ^= state << 17;
+    return static_cast<size_t>(state % sample.size());
+  };
+  int best_count = -1;
+  Plane best;
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    const Eigen::Vector3f a = to_eigen(pts[sample[next()]]).cast<float>();
+    const Eigen::Vector3f b = to_eigen(pts[sample[next()]]).cast<float>();
+    const Eigen::Vector3f c = to_eigen(pts[sample[next()]]).cast<float>();
+    Eigen::Vector3f n = (b - a).cross(c - a);
+    if (n.norm() < 1e-9f) continue;
+    n.normalize();
+    if (n.dot(a) > 0) n = -n;
+    Plane candidate{n, -n.dot(a)};
+    int count = 0;
+    for (int i : sample) count += std::abs(candidate.distance(to_eigen(pts[i]).cast<float>())) <= band;
+    if (count > best_count) { best_count = count; best = candidate; }
+  }
+  if (best_count <= 0) return 0;
+  std::vector<int> inliers;
+  for (int i : sample)
+    if (std::abs(best.distance(to_eigen(pts[i]).cast<float>())) <= band) inliers.push_back(i);
+  plane = best;
+  if (fit_plane(inliers, points, plane) && inlier_share(sample, points, plane, band) >= static_cast<double>(best_count) / sample.size())
+    return inlier_share(sample, points, plane, band);
+  plane = best;
+  return static_cast<double>(best_count) / sample.size();
+}
+
+// Pixels visited per object when classifying it against the table (a share is all we need).
+constexpr int kSamplesPerObject = 500;
+
+struct Heights {
+  int samples = 0, in_band = 0, above_max = 0, below = 0, over_region = 0;
+};
+
+}  // namespace
+
+std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat& points,
+                                     const std::vector<int>& object_of_patch,
+                                     const std::vector<float>& cut_cost, const Camera& camera) {
+  if (object_labels.type() != CV_32S || points.type() != CV_32FC3 || object_labels.size() != points.size())
+    throw Error("describe_objects: labels must be CV_32S and points CV_32FC3 of the same size");
+  double max_id = 0;
+  cv::minMaxLoc(object_labels, nullptr, &max_id);
+  const int count = static_cast<int>(max_id);
+  std::vector<Object> objects(static_cast<size_t>(std::max(0, count)));
+  const Eigen::Matrix3d rot = camera.camera_to_robot.topLeftCorner<3, 3>();
+  const Eigen::Vector3d shift = camera.camera_to_robot.topRightCorner<3, 1>();
+  const int total = static_cast<int>(object_labels.total());
+  const int* lab = object_labels.ptr<int>();
+  const auto* pts = points.ptr<cv::Vec3f>();
+
+  // Moments in the camera frame (6 products per pixel), moved to the robot frame once per object.
+  std::vector<Eigen::Matrix<double, 9, 1>> moments(objects.size(), Eigen::Matrix<double, 9, 1>::Zero());
+  std::vector<int> valid(objects.size(), 0);
+  for (int i = 0; i < total; ++i) {
+    if (lab[i] <= 0) continue;
+    const size_t o = static_cast<size_t>(lab[i] - 1);
+    ++objects[o].pixel_count;
+    if (!valid_point(pts[i])) continue;
+    const double x = pts[i][0], y = pts[i][1], z = pts[i][2];
+    moments[o] += (Eigen::Matrix<double, 9, 1>() << x, y, z, x * x, x * y, x * z, y * y, y * z, z * z).finished();
+    ++valid[o];
+  }
+  std::vector<Eigen::Matrix3d> axes(objects.size(), Eigen::Matrix3d::Identity());  // camera frame
+  std::vector<Eigen::Vector3d> low(objects.size(), Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()));
+  std::vector<Eigen::Vector3d> high(objects.size(), -low[0]);
+  for (size_t o = 0; o < objects.size(); ++o) {
+    objects[o].id = static_cast<int>(o) + 1;
+    objects[o].cut_cost = o < cut_cost.size() ? cut_cost[o] : std::numeric_limits<float>::infinity();
+    if (valid[o] == 0) continue;
+    const auto& m = moments[o];
+    const Eigen::Vector3d mean = m.head<3>() / valid[o];
+    Eigen::Matrix3d second;
+    second << m(3), m(4), m(5), m(4), m(6), m(7), m(5), m(7), m(8);
+    objects[o].centroid = (rot * mean + shift).cast<float>();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(second / valid[o] - mean * mean.transpose());
+    axes[o] = eig.eigenvectors();
+  }
+  for (int i = 0; i < total; ++i) {
+    if (lab[i] <= 0 || !valid_point(pts[i])) continue;
+    const size_t o = static_cast<size_t>(lab[i] - 1);
+    const Eigen::Vector3d c = axes[o].transpose() * to_eigen(pts[i]);
+    low[o] = low[o].cwiseMin(c);
+    high[o] = high[o].cwiseMax(c);
+  }
+  for (size_t o = 0; o < objects.size(); ++o) {
+    if (valid[o] == 0) continue;
+    // Axes ordered by extent, largest first, and right-handed.
+    const Eigen::Vector3d extent = high[o] - low[o];
+    std::array<int, 3> order = {0, 1, 2};
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return extent(a) > extent(b); });
+    OrientedBox& box = objects[o].box;
+    for (int k = 0; k < 3; ++k) {
+      box.axes.col(k) = (rot * axes[o].col(order[static_cast<size_t>(k)])).cast<float>();
+      box.extents(k) = static_cast<float>(extent(order[static_cast<size_t>(k)]));
+    }
+    box.axes.col(2) = box.axes.col(0).cross(box.axes.col(1));
+    box.center = (rot * (axes[o] * (0.5 * (low[o] + high[o]))) + shift).cast<float>();
+  }
+  for (size_t p = 0; p < object_of_patch.size(); ++p) {
+    const int o = object_of_patch[p];
+    if (o >= 0 && o < count) objects[static_cast<size_t>(o)].patches.push_back(static_cast<int>(p));
+  }
+  return objects;
+}
+
+std::optional<Plane> find_support(std::vector<Object>& objects, const std::vector<Patch>& patches,
+                                  const cv::Mat& object_labels, const cv::Mat& points,
+                                  const Params::Support& params) {
+  if (object_labels.type() != CV_32S || points.type() != CV_32FC3 || object_labels.size() != points.size())
+    throw Error("find_support: labels must be CV_32S and points CV_32FC3 of the same size");
+  const int* lab = object_labels.ptr<int>();
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const int total = static_cast<int>(object_labels.total());
+  const int num_objects = static_cast<int>(objects.size());
+  auto object_of_pixel = [&](int i) { return lab[i] > 0 && lab[i] <= num_objects ? lab[i] - 1 : -1; };
+
+  // Pixels of every object, visited with a stride (bounded work per object and candidate).
+  std::vector<std::vector<int>> samples(objects.size());
+  int valid_total = 0;
+  {
+    std::vector<int> stride(objects.size()), countdown(objects.size(), 0);
+    for (size_t o = 0; o < objects.size(); ++o) stride[o] = std::max(1, objects[o].pixel_count / kSamplesPerObject);
+    for (int i = 0; i < total; ++i) {
+      const int o = object_of_pixel(i);
+      if (o < 0) continue;
+      ++valid_total;
+      if (!valid_point(pts[i]) || countdown[static_cast<size_t>(o)]-- > 0) continue;
+      countdown[static_cast<size_t>(o)] = stride[static_cast<size_t>(o)] - 1;
+      samples[static_cast<size_t>(o)].push_back(i);
+    }
+  }
+
+  // Candidates: large flat patches, largest first (at most 4 are scored).
+  std::vector<int> candidates;
+  std::vector<Plane> planes(patches.size());
+  std::vector<bool> flat(patches.size(), false);
+  for (size_t p = 0; p < patches.size(); ++p) {
+    if (static_cast<double>(patches[p].pixels.size()) < 0.02 * valid_total) continue;
+    flat[p] = dominant_plane(patches[p].pixels, points, params.plane_band, planes[p]) >= 0.6;
+    if (flat[p]) candidates.push_back(static_cast<int>(p));
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
+    return patches[static_cast<size_t>(a)].pixels.size() > patches[static_cast<size_t>(b)].pixels.size();
+  });
+  if (candidates.size() > 4) candidates.resize(4);
+  if (candidates.empty()) return std::nullopt;
+  std::vector<int> candidate_of_pixel(static_cast<size_t>(total), -1);
+  for (size_t k = 0; k < candidates.size(); ++k)
+    for (int i : patches[static_cast<size_t>(candidates[k])].pixels) candidate_of_pixel[static_cast<size_t>(i)] = static_cast<int>(k);
+  std::vector<int> object_of_candidate;
+  for (int c : candidates) {
+    const auto& px = patches[static_cast<size_t>(c)].pixels;
+    object_of_candidate.push_back(px.empty() ? -1 : object_of_pixel(px[px.size() / 2]));
+  }
+
+  // Score: pixels of objects resting on the candidate (touching it, over its visible region), between
+  // the plane band and max_height on its camera-facing side. Objects holding a candidate (other large planes) do not
+  // count, so a wall does not score the table in front of it.
+  auto heights = [&](int o, const PlaneRegion& region) {
+    Heights h;
+    for (int i : samples[static_cast<size_t>(o)]) {
+      const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
+      const float d = region.plane.distance(q);
+      ++h.samples;
+      h.in_band += std::abs(d) <= params.plane_band;
+      h.above_max += d > params.max_height;
+      h.below += d < -params.plane_band;
+      h.over_region += region.over(q);
+    }
+    return h;
+  };
+  int best = -1;
+  double best_score = -1;
+  PlaneRegion best_region;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const Plane& plane = planes[static_cast<size_t>(candidates[k])];
+    const auto& px = patches[static_cast<size_t>(candidates[k])].pixels;
+    const PlaneRegion region = region_of(plane, px, points, params.region_margin);
+    double score = 0;
+    for (int o = 0; o < num_objects; ++o) {
+      // Other large planes (walls, other tables) are not mass on this one; the candidate's own object
+      // counts (objects the edges did not separate from the table stand on it).
+      if (o != object_of_candidate[k] &&
+          std::find(object_of_candidate.begin(), object_of_candidate.end(), o) != object_of_candidate.end()) continue;
+      // An object rests on the plane when its lowest point over the region is within contact_distance
+      // (a box in front of a wall floats 20 cm off it).
+      int resting = 0;
+      float lowest = std::numeric_limits<float>::infinity();
+      for (int i : samples[static_cast<size_t>(o)]) {
+        const int on_candidate = candidate_of_pixel[static_cast<size_t>(i)];
+        if (on_candidate >= 0 && on_candidate != static_cast<int>(k)) continue;  // another large plane
+        const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
+        const float d = plane.distance(q);
+        if (d <= -params.plane_band || d > params.max_height || !region.over(q)) continue;
+        lowest = std::min(lowest, d);
+        resting += d > params.plane_band;
+      }
+      if (lowest > params.contact_distance) continue;
+      // Back to pixel units: samples are a stride of the object's pixels.
+      if (!samples[static_cast<size_t>(o)].empty())
+        score += static_cast<double>(resting) / samples[static_cast<size_t>(o)].size() * objects[static_cast<size_t>(o)].pixel_count;
+    }
+    if (score > best_score) { best_score = score; best = static_cast<int>(k); best_region = region; }
+  }
+  if (best < 0) return std::nullopt;
+  // The table's visible region: every patch lying in its plane (objects split the table into pieces;
+  // objects at the back stand on pieces other than the largest).
+  {
+    std::vector<int> table_pixels;
+    for (const auto& patch : patches)
+      if (inlier_share(patch.pixels, points, best_region.plane, params.plane_band) >= 0.8)
+        table_pixels.insert(table_pixels.end(), patch.pixels.begin(), patch.pixels.end());
+    best_region = region_of(best_region.plane, table_pixels, points, params.region_margin);
+  }
+  const Plane& plane = best_region.plane;
+  const Eigen::Vector3f up = plane.normal;
+
+  for (int o = 0; o < num_objects; ++o) {
+    Object& object = objects[static_cast<size_t>(o)];
+    if (o == object_of_candidate[static_cast<size_t>(best)]) { object.support = true; continue; }
+    const Heights h = heights(o, best_region);
+    if (h.samples == 0) continue;
+    const double n = h.samples;
+    // Other pieces of the table (split off by occluding objects) lie in its plane.
+    if (h.in_band >= 0.8 * n) { object.support = true; continue; }
+    if (h.above_max > 0.5 * n || h.below > 0.5 * n || h.over_region < 0.3 * n) { object.background = true; continue; }
+    // Walls: large and flat, standing roughly perpendicular to the table.
+    int largest = -1;
+    for (int p : object.patches)
+      if (largest < 0 || patches[static_cast<size_t>(p)].pixels.size() > patches[static_cast<size_t>(largest)].pixels.size()) largest = p;
+    Plane own;
+    if (largest >= 0 && fit_plane(patches[static_cast<size_t>(largest)].pixels, points, own) &&
+        inlier_share(patches[static_cast<size_t>(largest)].pixels, points, own, params.plane_band) >= 0.9 &&
+        std::abs(own.normal.dot(up)) < std::cos(60.0 * M_PI / 180.0) &&
+        object.box.extents(0) >= params.wall_min_extent)
+      object.background = true;
+  }
+  return plane;
+}
+
+int split_support(cv::Mat& object_labels, std::vector<Object>& objects, const Plane& table, const cv::Mat& points,
+                  const Params::Support& params, int min_px, const Camera& camera) {
+  if (object_labels.type() != CV_32S || points.type() != CV_32FC3 || object_labels.size() != points.size())
+    throw Error("split_support: labels must be CV_32S and points CV_32FC3 of the same size");
+  cv::Mat clear(object_labels.size(), CV_8U, cv::Scalar(0));
+  const int num_objects = static_cast<int>(objects.size());
+  const int total = static_cast<int>(object_labels.total());
+  int* lab = object_labels.ptr<int>();
+  const auto* pts = points.ptr<cv::Vec3f>();
+  uchar* mask = clear.ptr<uchar>();
+  for (int i = 0; i < total; ++i) {
+    if (lab[i] <= 0 || lab[i] > num_objects || !objects[static_cast<size_t>(lab[i] - 1)].support || !valid_point(pts[i])) continue;
+    const float h = table.distance(to_eigen(pts[i]).cast<float>());
+    mask[i] = h > params.plane_band && h <= params.max_height ? 255 : 0;
+  }
+  // Groups: 8-connected, and neighbours closer than plane_band in 3D (a box in front of a keyboard is
+  // not one object with it). Each pixel enters the queue once: bounded.
+  std::vector<int> group(static_cast<size_t>(total), 0), queue;
+  const float link2 = static_cast<float>(params.plane_band * params.plane_band);
+  const int width = object_labels.cols, height = object_labels.rows;
+  int next = num_objects, added = 0;
+  std::vector<std::vector<int>> new_pixels;
+  for (int start = 0; start < total; ++start) {
+    if (!mask[start] || group[static_cast<size_t>(start)]) continue;
+    queue.assign(1, start);
+    group[static_cast<size_t>(start)] = -1;
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int i = queue[head], x = i % width, y = i / width;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = x + dx, yy = y + dy, j = yy * width + xx;
+          if (xx < 0 || yy < 0 || xx >= width || yy >= height || !mask[j] || group[static_cast<size_t>(j)]) continue;
+          const cv::Vec3f d = pts[i] - pts[j];
+          if (d.dot(d) >= link2) continue;
+          group[static_cast<size_t>(j)] = -1;
+          queue.push_back(j);
+        }
+    }
+    const int id = static_cast<int>(queue.size()) >= min_px ? ++next : 0;
+    added += id > 0;
+    if (id) new_pixels.push_back(queue);
+    for (int i : queue) {
+      group[static_cast<size_t>(i)] = 1;  // visited
+      if (id) lab[i] = id;
+    }
+  }
+  if (added == 0) return 0;
+  // Statistics of every object again (the support objects lost pixels); flags and patches are kept.
+  std::vector<Object> described = describe_objects(object_labels, points, {}, {}, camera);
+  for (size_t o = 0; o < objects.size(); ++o) {
+    described[o].patches = std::move(objects[o].patches);
+    described[o].cut_cost = objects[o].cut_cost;
+    described[o].support = objects[o].support;
+    described[o].background = objects[o].background;
+  }
+  objects = std::move(described);
+  // A wall standing on the table's edge came with it: large, flat and perpendicular to the table.
+  for (size_t k = 0; k < new_pixels.size(); ++k) {
+    Object& object = objects[static_cast<size_t>(num_objects) + k];
+    Plane own;
+    object.background = object.box.extents(0) >= params.wall_min_extent && fit_plane(new_pixels[k], points, own) &&
+                        inlier_share(new_pixels[k], points, own, params.plane_band) >= 0.9 &&
+                        std::abs(own.normal.dot(table.normal)) < std::cos(60.0 * M_PI / 180.0);
+  }
+  return added;
+}
 
 cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects) {
   // New ids keep the order of the old ones, so the view is as stable as the labels it comes from.

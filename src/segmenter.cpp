@@ -2,9 +2,21 @@
 
 #include <chrono>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "clutterseg/adjacency.hpp"
+#include "clutterseg/coplanarity.hpp"
+#include "clutterseg/curvature.hpp"
+#include "clutterseg/cutfree.hpp"
 #include "clutterseg/edges.hpp"
+#include "clutterseg/graph_cut.hpp"
 #include "clutterseg/normals.hpp"
+#include "clutterseg/objects.hpp"
 #include "clutterseg/parallel.hpp"
+#include "clutterseg/remaining.hpp"
 
 namespace clutterseg {
 
@@ -26,6 +38,16 @@ class Stopwatch {
   Timings& out_;
   Clock::time_point start_, last_;
 };
+
+// The patch graph of paper i): every link with its cue, weighted 1/deg and symmetrised.
+std::vector<GraphEdge> patch_graph(int num_patches, const std::vector<PatchPair>& adjacent,
+                                   const std::vector<PatchPair>& coplanar, const std::vector<CurvatureLink>& curved) {
+  std::vector<GraphEdge> links;
+  for (const auto& [a, b] : adjacent) links.push_back({a, b, Cue::Adjacent, 0});
+  for (const auto& [a, b] : coplanar) links.push_back({a, b, Cue::Coplanar, 0});
+  for (const auto& c : curved) links.push_back({c.pair.first, c.pair.second, c.cue, 0});
+  return weight_graph(num_patches, std::move(links));
+}
 
 cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
   if (depth.empty()) throw Error("depth image is empty");
@@ -65,9 +87,36 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   Patches patches = extract_patches(r.edges, r.points, r.normals, p.patches,     // c) surface patches
                                     px.area(p.patches.min_size_px));
   r.core_patch_labels = patches.labels;
-  r.patch_labels = patches.labels;
   r.patches = std::move(patches.patches);
   watch.mark("patches");
+  const int num_patches = static_cast<int>(r.patches.size());
+  const Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency
+                                                   px.length(p.adjacency.radius_px), p.adjacency.d_max);
+  r.patch_labels = assignment.labels;
+  watch.mark("assignment");
+  const std::vector<PatchPair> links = p.cutfree.enabled                                  // e) cut-free
+      ? cut_free_pairs(assignment.adjacent, r.patches, r.points, p.cutfree, p.seed) : assignment.adjacent;
+  watch.mark("cutfree");
+  std::vector<PatchPair> linked = links;
+  const std::vector<PatchPair> coplanar = p.coplanarity.enabled                         // f/g) co-planarity
+      ? coplanar_pairs(r.patches, linked, r.points, camera, p.coplanarity, p.seed) : std::vector<PatchPair>{};
+  linked.insert(linked.end(), coplanar.begin(), coplanar.end());
+  watch.mark("coplanarity");
+  const std::vector<CurvatureLink> curved = p.curvature.enabled                          // h) curvature
+      ? curvature_links(r.patches, linked, r.patch_labels, r.points, r.normals, camera, p) : std::vector<CurvatureLink>{};
+  watch.mark("curvature");
+  r.graph = patch_graph(num_patches, links, coplanar, curved);                           // i) graph cut
+  const Partition parts = cut_graph(num_patches, r.graph, p.graph.theta_c);
+  watch.mark("graph_cut");
+  r.object_labels = assign_remaining(r.patch_labels, parts.object_of_node,                       // j) remaining
+                                     static_cast<int>(parts.cut_cost.size()), r.points, p.remaining,
+                                     px.area(p.remaining.tiny_px), p.seed);
+  watch.mark("remaining");
+  r.objects = describe_objects(r.object_labels, r.points, parts.object_of_node, parts.cut_cost, camera);  // objects
+  r.support_plane = find_support(r.objects, r.patches, r.object_labels, r.points, p.support);   // table, walls
+  if (r.support_plane)                                                           // objects merged into it
+    split_support(r.object_labels, r.objects, *r.support_plane, r.points, p.support, px.area(p.patches.min_size_px), camera);
+  watch.mark("objects");
   watch.total();
   return r;
 }

@@ -82,6 +82,24 @@ inline TestScene staircase() {
   return {{{table(), box(1, {0, 0, 0.015}, {0.1, 0.07, 0.015}), box(2, {0, 0.04, 0.045}, {0.1, 0.07, 0.015})}}};
 }
 
+// Two boxes side by side, 2 cm apart, of different heights (so that no face of one continues a face
+// of the other).
+inline TestScene two_boxes_apart() {
+  return {{{table(), box(1, {-0.07, 0, 0.05}, {0.06, 0.05, 0.05}), box(2, {0.07, 0, 0.035}, {0.06, 0.05, 0.035})}}};
+}
+
+// A box on a table in front of a wall (a vertical plane 25 cm behind it, 60 cm high).
+inline TestScene box_before_wall() {
+  Shape wall;
+  wall.type = ShapeType::Plane;
+  wall.pose = Eigen::Translation3d(0, 0.25, 0.3) * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());
+  wall.size = {0.8, 0.3, 0};
+  wall.label = 0;
+  TestScene s{{{table(0.25), wall, box(1, {0, 0, 0.05}, {0.08, 0.06, 0.05}, 0.4)}}};
+  s.world_to_camera = synth::look_at({0, -0.7, 0.6}, {0, 0.05, 0.1});
+  return s;
+}
+
 // Two boxes of equal height with table between them: co-planar tops separated by background
 // (paper Fig. 5, red box), which must not be joined.
 inline TestScene separate_boxes() {

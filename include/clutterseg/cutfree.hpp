@@ -6,8 +6,8 @@
 namespace clutterseg {
 
 // True when a strict majority of `planes` RANSAC planes fitted to `cutter` leave `other` on one side
-// (points within +-band are on the plane; a plane fails when the minority side holds more than
-// wrong_side_fraction of other's points). Deterministic for a given seed.
+// (points within +-band are on the plane; a plane fails when the minority side holds more points than
+// wrong_side_fraction of the smaller patch's point count). Deterministic for a given seed.
 bool one_side_of(const Patch& cutter, const Patch& other, const cv::Mat& points,
                  const Params::CutFree& params, std::uint64_t seed);
 

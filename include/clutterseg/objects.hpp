@@ -20,6 +20,13 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
                                   const cv::Mat& object_labels, const cv::Mat& points,
                                   const Params::Support& params);
 
+// Objects the edges or links did not separate from the table: pixels of support objects standing
+// clear of the table plane (more than plane_band above it, at most max_height) form 8-connected groups;
+// each group of at least min_px pixels becomes a new object (labels changed in place, objects
+// appended with their statistics). Returns the number of new objects.
+int split_support(cv::Mat& object_labels, std::vector<Object>& objects, const Plane& table, const cv::Mat& points,
+                  const Params::Support& params, int min_px, const Camera& camera);
+
 // Copy of object_labels with support and background objects set to 0 and the rest renumbered 1..K.
 cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects);
 

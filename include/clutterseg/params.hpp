@@ -53,7 +53,8 @@ struct Params {
     bool enabled = true;
     int planes = 20;             // RANSAC planes per patch and direction
     double band = 0.008;         // points within +-band of a plane count as on it [m]
-    double wrong_side_fraction = 0.1;  // a plane cuts when more than this share lies on its minority side
+    double wrong_side_fraction = 0.1;  // a plane cuts when its minority side holds more points than this
+                                       // share of the smaller patch [-]
     double skip_angle_deg = 30;  // pairs with mean normals closer than this skip the test (the authors' choice)
     bool skip_similar = true;    // set false to always test
   } cutfree;
@@ -96,6 +97,11 @@ struct Params {
     bool objects_only = false;   // label 0 for the support plane and background surfaces
     double plane_band = 0.015;   // pixels within this of the table plane belong to it [m]
     double max_height = 0.5;     // objects higher above the table than this are background [m]
+    double contact_distance = 0.05;  // an object rests on a plane when its lowest point is this close [m]
+    double region_margin = 0.05; // an object stands on the table when it projects within this of the
+                                 // table's visible region (convex hull in the plane) [m]
+    double wall_min_extent = 0.35; // a flat object at least this large, roughly perpendicular to the
+                                   // table (> 60 deg), is a wall [m]
   } support;
 
   std::uint64_t seed = 1;        // every random choice is seeded from this

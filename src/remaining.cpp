@@ -1,0 +1,207 @@
+// Paper j): remaining points. Pixels no patch took are grown into segments (8-connected, Euclidean
+// distance between image neighbours), then each segment follows the paper's five rules:
+//   1. no neighbouring face (missing depth around it)       -> a new object (none if tiny: noise)
+//   2. one neighbouring face and tiny                       -> joins that face's object
+//   3. one face: enclosed by it -> a new object, else joins it
+//   4. several faces, all of one object                     -> joins that object
+//   5. faces of several objects -> every pixel joins the object whose neighbouring face's plane it
+//      fits best.
+// Choices the paper leaves open:
+// - "Neighbouring face" = a patch pixel 8-adjacent to the segment in the image.
+// - "Enclosed" = the segment does not touch the image border or another remaining segment, and the
+//   face holds at least half of its ring of neighbour pixels; the rest may be invalid pixels (the
+//   shadow a Kinect casts beside every small object must not make it part of the table).
+// - Rule 5 is decided per pixel, not per segment: the remaining pixels between two objects are mostly
+//   a bold edge band that belongs half to each, and boundaries decide the metrics. The plane of each
+//   neighbouring face is a least-squares fit to that face's pixels near the segment (local, so a
+//   curved face is modelled by its tangent plane where it touches the segment); least squares on all
+//   nearby pixels is deterministic and does not need RANSAC's random draws.
+#include "clutterseg/remaining.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace clutterseg {
+
+namespace {
+
+bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
+
+struct Segment {
+  std::vector<int> pixels;
+  cv::Rect bbox;
+};
+
+constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
+constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+
+// Least-squares plane of the pixels labelled `patch` in `window` (visited with a stride so that at most
+// about kMaxVisits pixels are read). Returns false when they are too few or collinear.
+constexpr int kMaxVisits = 4000;
+bool fit_local_plane(const cv::Mat& labels, const cv::Mat& points, int patch, cv::Rect window, Plane& plane) {
+  const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  int n = 0;
+  for (int y = window.y; y < window.y + window.height; y += stride) {
+    const int* lab = labels.ptr<int>(y);
+    const auto* pts = points.ptr<cv::Vec3f>(y);
+    for (int x = window.x; x < window.x + window.width; x += stride) {
+      if (lab[x] != patch || !valid_point(pts[x])) continue;
+      const Eigen::Vector3d q(pts[x][0], pts[x][1], pts[x][2]);
+      sum += q;
+      outer += q * q.transpose();
+      ++n;
+    }
+  }
+  if (n < 10) return false;
+  const Eigen::Vector3d mean = sum / n;
+  const Eigen::Matrix3d cov = outer / n - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  if (eig.eigenvalues()(1) < 1e-8) return false;  // a line of points (spread below 0.1 mm across)
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  if (normal.dot(mean) > 0) normal = -normal;  // facing the camera
+  plane.normal = normal.cast<float>();
+  plane.offset = static_cast<float>(-normal.dot(mean));
+  return true;
+}
+
+// Plane of `patch` near `bbox`: the window grows until the fit is possible (bounded: whole image).
+bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, const cv::Rect& bbox, Plane& plane) {
+  const cv::Rect image(0, 0, labels.cols, labels.rows);
+  int margin = std::max(8, std::max(bbox.width, bbox.height) / 2);
+  for (int attempt = 0; attempt < 8; ++attempt, margin *= 2) {
+    const cv::Rect window = cv::Rect(bbox.x - margin, bbox.y - margin, bbox.width + 2 * margin, bbox.height + 2 * margin) & image;
+    if (fit_local_plane(labels, points, patch, window, plane)) return true;
+    if (window == image) break;
+  }
+  return false;
+}
+
+}  // namespace
+
+cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
+                         int num_objects, const cv::Mat& points, const Params::Remaining& params,
+                         int tiny_px, std::uint64_t seed) {
+  (void)seed;  // least-squares planes: nothing random (see above)
+  if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || assigned_labels.size() != points.size())
+    throw Error("assign_remaining: labels must be CV_32S and points CV_32FC3 of the same size");
+  const int width = assigned_labels.cols, height = assigned_labels.rows;
+  const int total = width * height;
+  const int* lab = assigned_labels.ptr<int>();
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const int num_patches = static_cast<int>(object_of_patch.size());
+  for (int o : object_of_patch)
+    if (o < 0 || o >= num_objects) throw Error("assign_remaining: object index out of range");
+
+  cv::Mat objects(assigned_labels.size(), CV_32S, cv::Scalar(0));
+  int* obj = objects.ptr<int>();
+  for (int i = 0; i < total; ++i) {
+    if (lab[i] > num_patches) throw Error("assign_remaining: patch label out of range");
+    if (lab[i] > 0) obj[i] = object_of_patch[static_cast<size_t>(lab[i] - 1)] + 1;
+  }
+
+  // Region growing of the unassigned valid pixels; segment_of = index + 1, 0 = not remaining.
+  std::vector<int> segment_of(static_cast<size_t>(total), 0);
+  std::vector<Segment> segments;
+  const float grow2 = static_cast<float>(params.grow_distance * params.grow_distance);
+  std::vector<int> queue;
+  for (int seed_px = 0; seed_px < total; ++seed_px) {
+    if (lab[seed_px] != 0 || segment_of[static_cast<size_t>(seed_px)] || !valid_point(pts[seed_px])) continue;
+    Segment s;
+    const int id = static_cast<int>(segments.size()) + 1;
+    queue.assign(1, seed_px);
+    segment_of[static_cast<size_t>(seed_px)] = id;
+    int x0 = width, y0 = height, x1 = -1, y1 = -1;
+    for (size_t head = 0; head < queue.size(); ++head) {  // every pixel enters once: bounded
+      const int i = queue[head];
+      const int x = i % width, y = i / width;
+      x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
+      for (int k = 0; k < 8; ++k) {
+        const int xx = x + kDx[k], yy = y + kDy[k];
+        if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
+        const int j = yy * width + xx;
+        if (lab[j] != 0 || segment_of[static_cast<size_t>(j)] || !valid_point(pts[j])) continue;
+        const cv::Vec3f d = pts[i] - pts[j];
+        if (d.dot(d) >= grow2) continue;
+        segment_of[static_cast<size_t>(j)] = id;
+        queue.push_back(j);
+      }
+    }
+    s.pixels = queue;
+    s.bbox = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+    segments.push_back(std::move(s));
+  }
+
+  std::vector<int> ring_stamp(static_cast<size_t>(total), 0);  // last segment that counted this pixel
+  int next_object = num_objects;
+  for (size_t s = 0; s < segments.size(); ++s) {
+    const Segment& seg = segments[s];
+    const int id = static_cast<int>(s) + 1;
+    // The ring: pixels 8-adjacent to the segment, each counted once.
+    bool touches_border = false;
+    int other_segment = 0, invalid = 0;
+    std::vector<std::pair<int, int>> faces;  // (patch label, ring pixels)
+    for (int i : seg.pixels) {
+      const int x = i % width, y = i / width;
+      for (int k = 0; k < 8; ++k) {
+        const int xx = x + kDx[k], yy = y + kDy[k];
+        if (xx < 0 || yy < 0 || xx >= width || yy >= height) { touches_border = true; continue; }
+        const int j = yy * width + xx;
+        if (segment_of[static_cast<size_t>(j)] == id || ring_stamp[static_cast<size_t>(j)] == id) continue;
+        ring_stamp[static_cast<size_t>(j)] = id;
+        if (lab[j] > 0) {
+          auto it = std::find_if(faces.begin(), faces.end(), [&](const auto& f) { return f.first == lab[j]; });
+          if (it == faces.end()) faces.emplace_back(lab[j], 1); else ++it->second;
+        } else if (segment_of[static_cast<size_t>(j)]) {
+          ++other_segment;
+        } else {
+          ++invalid;
+        }
+      }
+    }
+    std::sort(faces.begin(), faces.end());  // by label: independent of the scan order
+    auto set_all = [&](int object_id) { for (int i : seg.pixels) obj[i] = object_id; };
+    auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
+
+    if (faces.empty()) {                                              // rule 1
+      // A tiny segment alone is sensor noise (stereo sensors leave thousands of them), not an object.
+      if (static_cast<int>(seg.pixels.size()) >= tiny_px) set_all(++next_object);
+      continue;
+    }
+    if (faces.size() == 1) {
+      const bool tiny = static_cast<int>(seg.pixels.size()) < tiny_px;          // rule 2
+      const bool enclosed = !touches_border && other_segment == 0 && faces[0].second >= invalid;  // rule 3
+      set_all(!tiny && enclosed ? ++next_object : object_of(faces[0].first));
+      continue;
+    }
+    const int first_object = object_of(faces[0].first);
+    if (std::all_of(faces.begin(), faces.end(), [&](const auto& f) { return object_of(f.first) == first_object; })) {
+      set_all(first_object);                                          // rule 4
+      continue;
+    }
+    // Rule 5: per pixel, the neighbouring face whose local plane fits best.
+    std::vector<std::pair<Plane, int>> planes;  // plane, object id
+    for (const auto& f : faces) {
+      Plane plane;
+      if (fit_plane_near(assigned_labels, points, f.first, seg.bbox, plane)) planes.emplace_back(plane, object_of(f.first));
+    }
+    if (planes.empty()) {  // only degenerate faces: the face with the longest contact takes it
+      const auto best = std::max_element(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+      set_all(object_of(best->first));
+      continue;
+    }
+    for (int i : seg.pixels) {
+      const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
+      float best = std::numeric_limits<float>::infinity();
+      for (const auto& [plane, object_id] : planes) {
+        const float d = std::abs(plane.distance(q));
+        if (d < best) { best = d; obj[i] = object_id; }
+      }
+    }
+  }
+  return objects;
+}
+
+}  // namespace clutterseg
