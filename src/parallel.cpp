@@ -9,8 +9,9 @@
 namespace clutterseg {
 
 void set_threads(int threads) {
-  // OpenCV's own pool (GaussianBlur, medianBlur, ...) follows the same setting.
-  cv::setNumThreads(threads > 0 ? threads : -1);
+  // OpenCV's calls here (median, Gaussian, components) are short; its pool's idle threads spin and
+  // took the cores our OpenMP rows needed (2 threads ran 4x slower than 1), so OpenCV stays serial.
+  cv::setNumThreads(1);
 #ifdef _OPENMP
   omp_set_num_threads(threads > 0 ? threads : omp_get_num_procs());
 #else
