@@ -24,7 +24,7 @@ struct SegmentOptions {
 void write_frame(const fs::path& out, const Frame& frame, const Result& r, const Params& params) {
   std::vector<std::pair<fs::path, cv::Mat>> images;
   const fs::path debug = out / "debug" / frame.name;
-  images.emplace_back(out / "patch" / (frame.name + ".png"), labels_to_u16(r.patch_labels));
+  images.emplace_back(out / "patch" / (frame.name + ".png"), labels_to_u16(r.core_patch_labels));  // 0 = edge
   if (!r.object_labels.empty()) {
     const cv::Mat labels = params.support.objects_only ? objects_only(r.object_labels, r.objects) : r.object_labels;
     images.emplace_back(out / "label" / (frame.name + ".png"), labels_to_u16(labels));
@@ -34,7 +34,7 @@ void write_frame(const fs::path& out, const Frame& frame, const Result& r, const
   images.emplace_back(debug / "normals.png", render_normals(r.normals));
   images.emplace_back(debug / "edges.png", render_edges(r.edges));
   images.emplace_back(debug / "edge_value.png", render_edge_value(r.edge_value));
-  images.emplace_back(debug / "patches.png", render_labels(r.patch_labels));
+  images.emplace_back(debug / "patches.png", render_labels(r.core_patch_labels));
   const std::string json = result_to_json(r, frame.name).dump(1) + "\n";
 
   std::vector<fs::path> written;
