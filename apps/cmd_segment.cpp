@@ -31,6 +31,7 @@ void write_frame(const fs::path& out, const Frame& frame, const Result& r, const
     images.emplace_back(debug / "objects.png", render_overlay(labels, frame.color, r.depth));
     images.emplace_back(debug / "graph.png", render_graph(r, frame.camera));
   }
+  images.emplace_back(debug / "depth.png", render_depth(r.depth));
   images.emplace_back(debug / "normals.png", render_normals(r.normals));
   images.emplace_back(debug / "edges.png", render_edges(r.edges));
   images.emplace_back(debug / "edge_value.png", render_edge_value(r.edge_value));
