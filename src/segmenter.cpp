@@ -17,27 +17,11 @@
 #include "clutterseg/objects.hpp"
 #include "clutterseg/parallel.hpp"
 #include "clutterseg/remaining.hpp"
+#include "clutterseg/stopwatch.hpp"
 
 namespace clutterseg {
 
 namespace {
-
-// Records the time since the previous mark under a stage name.
-class Stopwatch {
- public:
-  explicit Stopwatch(Timings& out) : out_(out), start_(Clock::now()), last_(start_) {}
-  void mark(const char* stage) {
-    const auto now = Clock::now();
-    out_.emplace_back(stage, std::chrono::duration<double, std::milli>(now - last_).count());
-    last_ = now;
-  }
-  void total() { out_.emplace_back("total", std::chrono::duration<double, std::milli>(Clock::now() - start_).count()); }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  Timings& out_;
-  Clock::time_point start_, last_;
-};
 
 // The patch graph of paper i): every link with its cue, weighted 1/deg and symmetrised.
 std::vector<GraphEdge> patch_graph(int num_patches, const std::vector<PatchPair>& adjacent,

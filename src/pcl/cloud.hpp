@@ -7,6 +7,7 @@
 
 #include <chrono>
 
+#include "clutterseg/stopwatch.hpp"
 #include "clutterseg/types.hpp"
 
 namespace clutterseg::baselines {
@@ -35,20 +36,5 @@ int scaled_px(int px_at_640x480, const cv::Size& size);
 // Relabels a label image so that the kept labels become 1..K in row-major order of first appearance.
 cv::Mat compact_labels(const cv::Mat& labels);
 
-class StageClock {
- public:
-  explicit StageClock(Timings& out) : out_(out), start_(Clock::now()), last_(start_) {}
-  void mark(const char* stage) {
-    const auto now = Clock::now();
-    out_.emplace_back(stage, std::chrono::duration<double, std::milli>(now - last_).count());
-    last_ = now;
-  }
-  void total() { out_.emplace_back("total", std::chrono::duration<double, std::milli>(Clock::now() - start_).count()); }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  Timings& out_;
-  Clock::time_point start_, last_;
-};
 
 }  // namespace clutterseg::baselines

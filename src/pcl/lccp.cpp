@@ -61,7 +61,7 @@ void drop_planar_segments(cv::Mat& labels, const pcl::PointCloud<PointT>& cloud,
 BaselineResult segment_lccp(const cv::Mat& depth, const Camera& camera, const cv::Mat& color, const LccpParams& p) {
   QuietPcl quiet;
   BaselineResult out;
-  StageClock clock(out.timings_ms);
+  Stopwatch clock(out.timings_ms);
   const auto cloud = depth_to_cloud(depth, camera, color);
   clock.mark("cloud");
 

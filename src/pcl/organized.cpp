@@ -14,7 +14,7 @@ namespace clutterseg::baselines {
 BaselineResult segment_organized(const cv::Mat& depth, const Camera& camera, const OrganizedParams& p) {
   QuietPcl quiet;
   BaselineResult out;
-  StageClock clock(out.timings_ms);
+  Stopwatch clock(out.timings_ms);
   const auto cloud = depth_to_cloud(depth, camera, {});
   clock.mark("cloud");
 
