@@ -1,6 +1,8 @@
 // Per-object outputs: statistics, the support plane (table) and the objects-only view.
 #include "clutterseg/objects.hpp"
 
+#include <array>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -174,39 +176,50 @@ std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat
   const int* lab = object_labels.ptr<int>();
   const auto* pts = points.ptr<cv::Vec3f>();
 
-  // Moments in the camera frame (6 products per pixel), moved to the robot frame once per object.
-  std::vector<Eigen::Matrix<double, 9, 1>> moments(objects.size(), Eigen::Matrix<double, 9, 1>::Zero());
+  // Moments in the camera frame (plain arrays: this pass touches every pixel), moved to the robot
+  // frame once per object.
+  std::vector<std::array<double, 9>> moments(objects.size(), std::array<double, 9>{});
   std::vector<int> valid(objects.size(), 0);
   for (int i = 0; i < total; ++i) {
     if (lab[i] <= 0) continue;
     const size_t o = static_cast<size_t>(lab[i] - 1);
     ++objects[o].pixel_count;
-    if (!valid_point(pts[i])) continue;
+    if (!(pts[i][2] > 0)) continue;
     const double x = pts[i][0], y = pts[i][1], z = pts[i][2];
-    moments[o] += (Eigen::Matrix<double, 9, 1>() << x, y, z, x * x, x * y, x * z, y * y, y * z, z * z).finished();
+    auto& m = moments[o];
+    m[0] += x; m[1] += y; m[2] += z;
+    m[3] += x * x; m[4] += x * y; m[5] += x * z; m[6] += y * y; m[7] += y * z; m[8] += z * z;
     ++valid[o];
   }
-  std::vector<Eigen::Matrix3d> axes(objects.size(), Eigen::Matrix3d::Identity());  // camera frame
-  std::vector<Eigen::Vector3d> low(objects.size(), Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()));
-  std::vector<Eigen::Vector3d> high(objects.size(), -low[0]);
+  std::vector<Eigen::Matrix3f> axes_t(objects.size(), Eigen::Matrix3f::Identity());  // rows: axes, camera frame
+  std::vector<Eigen::Matrix3d> axes(objects.size(), Eigen::Matrix3d::Identity());
   for (size_t o = 0; o < objects.size(); ++o) {
     objects[o].id = static_cast<int>(o) + 1;
     objects[o].cut_cost = o < cut_cost.size() ? cut_cost[o] : std::numeric_limits<float>::infinity();
     if (valid[o] == 0) continue;
     const auto& m = moments[o];
-    const Eigen::Vector3d mean = m.head<3>() / valid[o];
+    const Eigen::Vector3d mean = Eigen::Vector3d(m[0], m[1], m[2]) / valid[o];
     Eigen::Matrix3d second;
-    second << m(3), m(4), m(5), m(4), m(6), m(7), m(5), m(7), m(8);
+    second << m[3], m[4], m[5], m[4], m[6], m[7], m[5], m[7], m[8];
     objects[o].centroid = (rot * mean + shift).cast<float>();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(second / valid[o] - mean * mean.transpose());
     axes[o] = eig.eigenvectors();
+    axes_t[o] = axes[o].transpose().cast<float>();
   }
+  // Extents along the axes: float is plenty for millimetres at a few metres.
+  std::vector<Eigen::Vector3f> low_f(objects.size(), Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity()));
+  std::vector<Eigen::Vector3f> high_f(objects.size(), -low_f[0]);
   for (int i = 0; i < total; ++i) {
-    if (lab[i] <= 0 || !valid_point(pts[i])) continue;
+    if (lab[i] <= 0 || !(pts[i][2] > 0)) continue;
     const size_t o = static_cast<size_t>(lab[i] - 1);
-    const Eigen::Vector3d c = axes[o].transpose() * to_eigen(pts[i]);
-    low[o] = low[o].cwiseMin(c);
-    high[o] = high[o].cwiseMax(c);
+    const Eigen::Vector3f c = axes_t[o] * Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
+    low_f[o] = low_f[o].cwiseMin(c);
+    high_f[o] = high_f[o].cwiseMax(c);
+  }
+  std::vector<Eigen::Vector3d> low(objects.size()), high(objects.size());
+  for (size_t o = 0; o < objects.size(); ++o) {
+    low[o] = low_f[o].cast<double>();
+    high[o] = high_f[o].cast<double>();
   }
   for (size_t o = 0; o < objects.size(); ++o) {
     if (valid[o] == 0) continue;
