@@ -1,12 +1,5 @@
 #include "clutterseg/segmenter.hpp"
 
-#include <chrono>
-
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <numeric>
-
 #include "clutterseg/adjacency.hpp"
 #include "clutterseg/coplanarity.hpp"
 #include "clutterseg/curvature.hpp"
