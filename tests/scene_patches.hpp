@@ -1,6 +1,8 @@
 // Finding the patches of a segmented test scene by its ground-truth labels.
 #pragma once
 
+#include <algorithm>
+#include <map>
 #include <vector>
 
 #include "clutterseg/segmenter.hpp"
@@ -17,6 +19,25 @@ inline Segmented segment_scene(const TestScene& scene, const Params& params = {}
   Segmented s{scene.render(), {}};
   s.result = segment(s.truth.depth, scene.camera, params);
   return s;
+}
+
+// Majority ground-truth label of a pixel list (0 = table).
+inline int majority_label(const std::vector<int>& pixels, const cv::Mat& truth_labels) {
+  std::map<int, int> count;
+  for (int i : pixels) ++count[truth_labels.ptr<int>()[i]];
+  if (count.empty()) return 0;
+  return std::max_element(count.begin(), count.end(), [](auto& a, auto& b) { return a.second < b.second; })->first;
+}
+
+// Share of the measured pixels of ground-truth `label` that `view` labels non-zero.
+inline double kept_share(const cv::Mat& view, const cv::Mat& truth, int label, const cv::Mat& depth) {
+  int n = 0, kept = 0;
+  for (int i = 0; i < static_cast<int>(view.total()); ++i) {
+    if (truth.ptr<int>()[i] != label || depth.ptr<float>()[i] <= 0) continue;
+    ++n;
+    kept += view.ptr<int>()[i] > 0;
+  }
+  return n ? static_cast<double>(kept) / n : 0.0;
 }
 
 // Indices of the patches lying entirely on ground-truth object `label`, in patch order.

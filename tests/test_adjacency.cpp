@@ -10,6 +10,7 @@
 #include "clutterseg/io.hpp"
 #include "clutterseg/normals.hpp"
 #include "clutterseg/segmenter.hpp"
+#include "scene_patches.hpp"
 #include "scenes.hpp"
 
 using namespace clutterseg;
@@ -77,11 +78,8 @@ Stage presegment(const scenes::TestScene& scene) {
   return s;
 }
 
-// Majority ground-truth label of a patch (0 = table).
 int truth_of(const Stage& s, int patch_index) {
-  std::map<int, int> count;
-  for (int i : s.pre.patches[static_cast<size_t>(patch_index)].pixels) ++count[s.truth.labels.ptr<int>()[i]];
-  return std::max_element(count.begin(), count.end(), [](auto& a, auto& b) { return a.second < b.second; })->first;
+  return scenes::majority_label(s.pre.patches[static_cast<size_t>(patch_index)].pixels, s.truth.labels);
 }
 
 }  // namespace

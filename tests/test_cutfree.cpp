@@ -6,6 +6,7 @@
 #include "clutterseg/adjacency.hpp"
 #include "clutterseg/cutfree.hpp"
 #include "clutterseg/segmenter.hpp"
+#include "scene_patches.hpp"
 #include "scenes.hpp"
 
 using namespace clutterseg;
@@ -54,9 +55,7 @@ Stage presegment(const scenes::TestScene& scene) {
 }
 
 int truth_of(const Stage& s, int patch_index) {
-  std::map<int, int> count;
-  for (int i : s.pre.patches[static_cast<size_t>(patch_index)].pixels) ++count[s.truth.labels.ptr<int>()[i]];
-  return std::max_element(count.begin(), count.end(), [](auto& x, auto& y) { return x.second < y.second; })->first;
+  return scenes::majority_label(s.pre.patches[static_cast<size_t>(patch_index)].pixels, s.truth.labels);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "clutterseg/normals.hpp"
 #include "clutterseg/objects.hpp"
 #include "clutterseg/segmenter.hpp"
+#include "scene_patches.hpp"
 #include "scenes.hpp"
 
 using namespace clutterseg;
@@ -16,16 +17,6 @@ Result run(const scenes::TestScene& scene, const synth::Rendering& truth) {
   return segment(truth.depth, scene.camera, p);
 }
 
-// Share of the pixels with ground-truth label `label` that the view labels non-zero.
-double kept_share(const cv::Mat& view, const cv::Mat& truth, int label, const cv::Mat& depth) {
-  int n = 0, kept = 0;
-  for (int i = 0; i < static_cast<int>(view.total()); ++i) {
-    if (truth.ptr<int>()[i] != label || depth.ptr<float>()[i] <= 0) continue;
-    ++n;
-    kept += view.ptr<int>()[i] > 0;
-  }
-  return n ? static_cast<double>(kept) / n : 0.0;
-}
 
 }  // namespace
 
@@ -69,8 +60,8 @@ TEST(Objects, TableIsTheSupportAndObjectsOnlyDropsIt) {
   const Eigen::Vector3f up = (scene.world_to_camera.linear() * Eigen::Vector3d::UnitZ()).cast<float>();
   EXPECT_GT(r.support_plane->normal.dot(up), 0.999f);
   const cv::Mat view = objects_only(r.object_labels, r.objects);
-  EXPECT_LT(kept_share(view, truth.labels, 0, truth.depth), 0.01);
-  EXPECT_GT(kept_share(view, truth.labels, 1, truth.depth), 0.95);
+  EXPECT_LT(scenes::kept_share(view, truth.labels, 0, truth.depth), 0.01);
+  EXPECT_GT(scenes::kept_share(view, truth.labels, 1, truth.depth), 0.95);
   EXPECT_EQ(std::count_if(r.objects.begin(), r.objects.end(), [](const Object& o) { return o.support; }), 1);
 }
 
@@ -90,8 +81,8 @@ TEST(Objects, WallIsBackgroundAndTheBoxIsKept) {
   const Eigen::Vector3f up = (scene.world_to_camera.linear() * Eigen::Vector3d::UnitZ()).cast<float>();
   EXPECT_GT(r.support_plane->normal.dot(up), 0.99f);  // the table, not the wall
   const cv::Mat view = objects_only(r.object_labels, r.objects);
-  EXPECT_LT(kept_share(view, truth.labels, 0, truth.depth), 0.02);  // table and wall dropped
-  EXPECT_GT(kept_share(view, truth.labels, 1, truth.depth), 0.95);
+  EXPECT_LT(scenes::kept_share(view, truth.labels, 0, truth.depth), 0.02);  // table and wall dropped
+  EXPECT_GT(scenes::kept_share(view, truth.labels, 1, truth.depth), 0.95);
 }
 
 TEST(Objects, StackedBoxesStaySeparateAndSameInputGivesSameLabels) {
@@ -124,8 +115,8 @@ TEST(Objects, ObjectMergedIntoTheTableIsSplitOff) {
   ASSERT_EQ(objects.size(), 2u);
   EXPECT_FALSE(objects[1].support || objects[1].background);
   const cv::Mat view = objects_only(labels, objects);
-  EXPECT_GT(kept_share(view, truth.labels, 1, truth.depth), 0.8);  // the box but its bottom 15 mm
-  EXPECT_LT(kept_share(view, truth.labels, 0, truth.depth), 0.01);
+  EXPECT_GT(scenes::kept_share(view, truth.labels, 1, truth.depth), 0.8);  // the box but its bottom 15 mm
+  EXPECT_LT(scenes::kept_share(view, truth.labels, 0, truth.depth), 0.01);
 }
 
 TEST(Objects, SameLabelsForAnyThreadCount) {

@@ -9,6 +9,7 @@
 #include "clutterseg/graph_cut.hpp"
 #include "clutterseg/objects.hpp"
 #include "clutterseg/segmenter.hpp"
+#include "scene_patches.hpp"
 #include "scenes.hpp"
 
 using namespace clutterseg;
@@ -92,16 +93,6 @@ cv::Mat split_label(const scenes::TestScene& scene, const synth::Rendering& trut
   return out;
 }
 
-// Share of the pixels of ground-truth `label` that `view` labels non-zero.
-double kept_share(const cv::Mat& view, const cv::Mat& truth, int label, const cv::Mat& depth) {
-  int n = 0, kept = 0;
-  for (int i = 0; i < static_cast<int>(view.total()); ++i) {
-    if (truth.ptr<int>()[i] != label || depth.ptr<float>()[i] <= 0) continue;
-    ++n;
-    kept += view.ptr<int>()[i] > 0;
-  }
-  return n ? static_cast<double>(kept) / n : 0.0;
-}
 
 struct Run {
   synth::Rendering truth;
@@ -222,11 +213,11 @@ TEST_P(PipelineAt, TableIsItsOwnObjectAndObjectsOnlyDropsIt) {
     const Overlap overlap(r.truth.labels, r.result.object_labels, r.truth.depth);
     EXPECT_TRUE(overlap.found(0)) << overlap.describe();
     const cv::Mat view = objects_only(r.result.object_labels, r.result.objects);
-    EXPECT_LT(kept_share(view, r.truth.labels, 0, r.truth.depth), 0.02);
+    EXPECT_LT(scenes::kept_share(view, r.truth.labels, 0, r.truth.depth), 0.02);
     for (size_t s = 1; s < scene.scene.shapes.size(); ++s) {
       const int label = scene.scene.shapes[s].label;
       EXPECT_NE(overlap.majority(label), overlap.majority(0)) << "object " << label << ":" << overlap.describe();
-      EXPECT_GT(kept_share(view, r.truth.labels, label, r.truth.depth), 0.9) << "object " << label;
+      EXPECT_GT(scenes::kept_share(view, r.truth.labels, label, r.truth.depth), 0.9) << "object " << label;
     }
   }
 }
