@@ -207,8 +207,9 @@ std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat
     axes_t[o] = axes[o].transpose().cast<float>();
   }
   // Extents along the axes: float is plenty for millimetres at a few metres.
-  std::vector<Eigen::Vector3f> low_f(objects.size(), Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity()));
-  std::vector<Eigen::Vector3f> high_f(objects.size(), -low_f[0]);
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  std::vector<Eigen::Vector3f> low_f(objects.size(), Eigen::Vector3f::Constant(kInf));
+  std::vector<Eigen::Vector3f> high_f(objects.size(), Eigen::Vector3f::Constant(-kInf));
   for (int i = 0; i < total; ++i) {
     if (lab[i] <= 0 || !(pts[i][2] > 0)) continue;
     const size_t o = static_cast<size_t>(lab[i] - 1);

@@ -259,3 +259,22 @@ TEST(Pipeline, DenseGraphOf300NodesGivesAValidPartition) {
   for (int v = 0; v < n; ++v) EXPECT_EQ(parts.object_of_node[v] == parts.object_of_node[0], v < half) << v;
   for (float cost : parts.cut_cost) EXPECT_GE(cost, 0.5f);  // no cheaper cut was left
 }
+
+// Regression: describe_objects read the first element of an empty vector when a frame had no object
+// (found by feeding the CLI a 1x1 image and pure noise).
+TEST(PipelineEdgeCases, FramesWithoutPatchesGiveNoObjectsAndDoNotCrash) {
+  Params p;
+  p.smoothing.temporal = false;
+  const Camera tiny = synth::default_camera(4, 3);
+  const Result one = segment(cv::Mat(3, 4, CV_32F, cv::Scalar(1.0f)), tiny, p);
+  EXPECT_TRUE(one.objects.empty() || cv::countNonZero(one.object_labels) > 0);
+  cv::Mat noise(240, 320, CV_32F);
+  cv::RNG(3).fill(noise, cv::RNG::UNIFORM, 0.4, 4.0);  // every pixel a depth jump: all edges
+  const Result r = segment(noise, synth::default_camera(320, 240), p);
+  EXPECT_TRUE(r.patches.empty());
+  for (const auto& o : r.objects) EXPECT_GT(o.pixel_count, 0);
+  cv::Mat sparse(240, 320, CV_32F, cv::Scalar(0));
+  for (int y = 0; y < 240; y += 2)
+    for (int x = 0; x < 320; x += 2) sparse.at<float>(y, x) = 1.0f;  // every other pixel missing
+  EXPECT_NO_THROW(segment(sparse, synth::default_camera(320, 240), p));
+}
