@@ -64,22 +64,12 @@ cv::Mat points_of(const cv::Mat& depth) {
   return depth_to_points(depth, camera);
 }
 
-struct Stage {
-  Result pre;   // pre-segmentation (core patches)
-  synth::Rendering truth;
-};
+using Stage = scenes::Segmented;  // pre-segmentation (core patches) and ground truth
 
-Stage presegment(const scenes::TestScene& scene) {
-  Stage s;
-  s.truth = scene.render();
-  Params p;
-  p.smoothing.temporal = false;
-  s.pre = segment(s.truth.depth, scene.camera, p);
-  return s;
-}
+Stage presegment(const scenes::TestScene& scene) { return scenes::segment_scene(scene); }
 
 int truth_of(const Stage& s, int patch_index) {
-  return scenes::majority_label(s.pre.patches[static_cast<size_t>(patch_index)].pixels, s.truth.labels);
+  return scenes::majority_label(s.result.patches[static_cast<size_t>(patch_index)].pixels, s.truth.labels);
 }
 
 }  // namespace
@@ -128,8 +118,8 @@ TEST(Adjacency, PixelsBeyondRadiusOrDistanceStayUnassigned) {
 
 TEST(Adjacency, BoxFacesAreAdjacentToEachOtherAndTheSidesToTheTable) {
   const Stage s = presegment(scenes::box_on_plane());
-  const Assignment a = assign_edge_pixels(s.pre.core_patch_labels, s.pre.points,
-                                          static_cast<int>(s.pre.patches.size()), 7, 0.015);
+  const Assignment a = assign_edge_pixels(s.result.core_patch_labels, s.result.points,
+                                          static_cast<int>(s.result.patches.size()), 7, 0.015);
   int box_box = 0, box_table = 0;
   for (const auto& [p, q] : a.adjacent) {
     const int tp = truth_of(s, p), tq = truth_of(s, q);
@@ -140,7 +130,7 @@ TEST(Adjacency, BoxFacesAreAdjacentToEachOtherAndTheSidesToTheTable) {
   EXPECT_GE(box_table, 1);
   // Edge pixels go to the object they lie on: count box edge pixels given to the table.
   int wrong = 0, assigned = 0;
-  const int* core = s.pre.core_patch_labels.ptr<int>();
+  const int* core = s.result.core_patch_labels.ptr<int>();
   for (int i = 0; i < static_cast<int>(a.labels.total()); ++i) {
     const int l = a.labels.ptr<int>()[i];
     if (core[i] != 0 || l == 0) continue;
@@ -158,13 +148,13 @@ TEST(Adjacency, FastMatchesNaiveScanOnTestScenes) {
                             scenes::side_by_side_boxes(), scenes::staircase(), scenes::cup(),
                             scenes::lying_cylinder_occluded()}) {
     const Stage s = presegment(scene);
-    const int n = static_cast<int>(s.pre.patches.size());
-    const Assignment fast = assign_edge_pixels(s.pre.core_patch_labels, s.pre.points, n, 7, 0.015);
-    const Assignment naive = naive_assignment(s.pre.core_patch_labels, s.pre.points, 7, 0.015);
+    const int n = static_cast<int>(s.result.patches.size());
+    const Assignment fast = assign_edge_pixels(s.result.core_patch_labels, s.result.points, n, 7, 0.015);
+    const Assignment naive = naive_assignment(s.result.core_patch_labels, s.result.points, 7, 0.015);
     EXPECT_EQ(fast.adjacent, naive.adjacent);
     int differ = 0, edge = 0;
     for (int i = 0; i < static_cast<int>(fast.labels.total()); ++i) {
-      edge += s.pre.core_patch_labels.ptr<int>()[i] == 0;
+      edge += s.result.core_patch_labels.ptr<int>()[i] == 0;
       differ += fast.labels.ptr<int>()[i] != naive.labels.ptr<int>()[i];
     }
     EXPECT_LE(differ, edge / 200) << differ << " of " << edge << " edge pixels differ";
@@ -173,9 +163,9 @@ TEST(Adjacency, FastMatchesNaiveScanOnTestScenes) {
 
 TEST(Adjacency, SameInputSameOutput) {
   const Stage s = presegment(scenes::occluded_box());
-  const int n = static_cast<int>(s.pre.patches.size());
-  const Assignment a = assign_edge_pixels(s.pre.core_patch_labels, s.pre.points, n, 7, 0.015);
-  const Assignment b = assign_edge_pixels(s.pre.core_patch_labels, s.pre.points, n, 7, 0.015);
+  const int n = static_cast<int>(s.result.patches.size());
+  const Assignment a = assign_edge_pixels(s.result.core_patch_labels, s.result.points, n, 7, 0.015);
+  const Assignment b = assign_edge_pixels(s.result.core_patch_labels, s.result.points, n, 7, 0.015);
   EXPECT_EQ(a.adjacent, b.adjacent);
   EXPECT_EQ(cv::countNonZero(a.labels != b.labels), 0);
 }

@@ -38,24 +38,18 @@ auto grid(Eigen::Vector3f origin, Eigen::Vector3f e1, Eigen::Vector3f e2) {
   return [=](int i) { return Eigen::Vector3f(origin + 0.01f * static_cast<float>(i % 10) * e1 + 0.01f * static_cast<float>(i / 10) * e2); };
 }
 
-struct Stage {
-  Result pre;
-  synth::Rendering truth;
+struct Stage : scenes::Segmented {
   std::vector<PatchPair> adjacent;
 };
 
 Stage presegment(const scenes::TestScene& scene) {
-  Stage s;
-  s.truth = scene.render();
-  Params p;
-  p.smoothing.temporal = false;
-  s.pre = segment(s.truth.depth, scene.camera, p);
-  s.adjacent = assign_edge_pixels(s.pre.core_patch_labels, s.pre.points, static_cast<int>(s.pre.patches.size()), 7, 0.015).adjacent;
+  Stage s{scenes::segment_scene(scene), {}};
+  s.adjacent = assign_edge_pixels(s.result.core_patch_labels, s.result.points, static_cast<int>(s.result.patches.size()), 7, 0.015).adjacent;
   return s;
 }
 
 int truth_of(const Stage& s, int patch_index) {
-  return scenes::majority_label(s.pre.patches[static_cast<size_t>(patch_index)].pixels, s.truth.labels);
+  return scenes::majority_label(s.result.patches[static_cast<size_t>(patch_index)].pixels, s.truth.labels);
 }
 
 }  // namespace
@@ -91,7 +85,7 @@ TEST(CutFree, ToleranceAllowsAFewWrongSidePoints) {
 TEST(CutFree, BoxOnTableKeepsFaceLinksAndDropsTableLinks) {
   const Stage s = presegment(scenes::box_on_plane());
   Params::CutFree p;
-  const auto kept = cut_free_pairs(s.adjacent, s.pre.patches, s.pre.points, p, 1);
+  const auto kept = cut_free_pairs(s.adjacent, s.result.patches, s.result.points, p, 1);
   int box_box = 0;
   for (const auto& [a, b] : s.adjacent) box_box += truth_of(s, a) == 1 && truth_of(s, b) == 1;
   int kept_box_box = 0;
@@ -105,7 +99,7 @@ TEST(CutFree, BoxOnTableKeepsFaceLinksAndDropsTableLinks) {
 
 TEST(CutFree, StackedBoxesAreNotLinked) {
   const Stage s = presegment(scenes::stacked_boxes());
-  const auto kept = cut_free_pairs(s.adjacent, s.pre.patches, s.pre.points, Params::CutFree{}, 1);
+  const auto kept = cut_free_pairs(s.adjacent, s.result.patches, s.result.points, Params::CutFree{}, 1);
   bool lower_upper_adjacent = false;
   for (const auto& [a, b] : s.adjacent) lower_upper_adjacent |= truth_of(s, a) + truth_of(s, b) == 3 && truth_of(s, a) != 0 && truth_of(s, b) != 0;
   EXPECT_TRUE(lower_upper_adjacent);  // the test means something: the upper box touches the lower one
@@ -114,7 +108,7 @@ TEST(CutFree, StackedBoxesAreNotLinked) {
 
 TEST(CutFree, TwoBoxesSideBySideAreNotLinked) {
   const Stage s = presegment(scenes::two_boxes_apart());
-  const auto kept = cut_free_pairs(s.adjacent, s.pre.patches, s.pre.points, Params::CutFree{}, 1);
+  const auto kept = cut_free_pairs(s.adjacent, s.result.patches, s.result.points, Params::CutFree{}, 1);
   for (const auto& [a, b] : kept) EXPECT_EQ(truth_of(s, a), truth_of(s, b)) << a << "-" << b;
 }
 
@@ -134,7 +128,7 @@ TEST(CutFree, SameSeedSameResult) {
   const Stage s = presegment(scenes::occluded_box());
   Params::CutFree p;
   p.skip_similar = false;
-  const auto a = cut_free_pairs(s.adjacent, s.pre.patches, s.pre.points, p, 7);
-  const auto b = cut_free_pairs(s.adjacent, s.pre.patches, s.pre.points, p, 7);
+  const auto a = cut_free_pairs(s.adjacent, s.result.patches, s.result.points, p, 7);
+  const auto b = cut_free_pairs(s.adjacent, s.result.patches, s.result.points, p, 7);
   EXPECT_EQ(a, b);
 }
