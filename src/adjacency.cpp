@@ -16,7 +16,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
+#include <limits>
+#include <opencv2/imgproc.hpp>
 
 namespace clutterseg {
 
@@ -24,34 +25,43 @@ namespace {
 
 bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
 
-float squared_distance(const cv::Vec3f& a, const cv::Vec3f& b) {
-  const cv::Vec3f d = a - b;
-  return d.dot(d);
-}
-
 // Seeds kept per pixel: one per patch, the nearest kMaxSeeds patches.
 constexpr int kMaxSeeds = 4;
 
 struct Seed {
   cv::Vec3f point;    // the patch pixel's 3D point (carried along: no random reads of the cloud)
+  float d2;           // squared 3D distance to the pixel holding it; for a pixel without depth, the squared
+                      // image distance instead (it only relays, keeping the seeds nearest in the image)
   int label;          // patch id 1..N
   int pixel;          // linear index of the patch pixel
   std::int16_t x, y;  // its image position (no division in the inner loop)
-  float d2;    // squared 3D distance to the pixel holding it; for a pixel without depth, the squared
-               // image distance instead (it only relays, keeping the seeds nearest in the image)
 };
+
+// Strict order on seeds competing for one slot: nearer first, ties to the smaller pixel index (or
+// label), so that the result does not depend on the order neighbours are visited.
+bool nearer(const Seed& a, const Seed& b) { return a.d2 < b.d2 || (a.d2 == b.d2 && a.pixel < b.pixel); }
 
 struct SeedSet {
   Seed seed[kMaxSeeds];
   int count = 0;
-  // Keeps the nearest seed per label and the kMaxSeeds nearest labels; ties go to the smaller pixel
-  // index so that the result does not depend on the order neighbours are visited.
-  void offer(const Seed& s) {
+  // Offers the seed of patch pixel `from` (at image distance^2 `image_d2`) to the pixel at `here`:
+  // keeps the nearest seed per label and the kMaxSeeds nearest labels. Neighbours mostly pass on a seed
+  // this set already holds, so that case returns before any distance is computed.
+  void offer(const cv::Vec3f& point, int label, int pixel, int x, int y, const cv::Vec3f* here, int image_d2) {
+    int slot = -1;
     for (int i = 0; i < count; ++i)
-      if (seed[i].label == s.label) {
-        if (s.d2 < seed[i].d2 || (s.d2 == seed[i].d2 && s.pixel < seed[i].pixel)) seed[i] = s;
-        return;
+      if (seed[i].label == label) {
+        if (seed[i].pixel == pixel) return;
+        slot = i;
+        break;
       }
+    const cv::Vec3f d = here ? point - *here : cv::Vec3f();
+    const Seed s{point, here ? d.dot(d) : static_cast<float>(image_d2), label, pixel,
+                 static_cast<std::int16_t>(x), static_cast<std::int16_t>(y)};
+    if (slot >= 0) {
+      if (nearer(s, seed[slot])) seed[slot] = s;
+      return;
+    }
     if (count < kMaxSeeds) { seed[count++] = s; return; }
     int worst = 0;
     for (int i = 1; i < count; ++i)
@@ -60,8 +70,6 @@ struct SeedSet {
   }
 };
 
-constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
-constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
 
 }  // namespace
 
@@ -79,52 +87,58 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   const int* lab = patch_labels.ptr<int>();
   const auto* pts = points.ptr<cv::Vec3f>();
 
-  // Pixels that carry seeds: non-patch pixels with depth, and pixels without depth next to one (seeds
-  // cross holes of 1-2 px inside an edge band, but do not flood the large regions without depth).
-  auto next_to_depth = [&](int x, int y) {
-    for (int n = 0; n < 8; ++n) {
-      const int xx = x + kDx[n], yy = y + kDy[n];
-      if (xx >= 0 && yy >= 0 && xx < width && yy < height && valid_point(pts[yy * width + xx])) return true;
-    }
-    return false;
+  // What each pixel is to the propagation (one lookup per neighbour): a patch pixel with depth (a
+  // source of seeds), a carrier of seeds (its index into `seeds`), or neither. Carriers are the non-patch
+  // pixels with depth and the pixels without depth next to one (seeds cross holes of 1-2 px inside an
+  // edge band, but do not flood the large regions without depth).
+  constexpr int kSource = -2, kNeither = -1;
+  cv::Mat depth_plane, has_depth, near_depth;
+  cv::extractChannel(points, depth_plane, 2);
+  has_depth = (depth_plane > 0) & (depth_plane < std::numeric_limits<float>::max());  // NaN compares false
+  cv::dilate(has_depth, near_depth, cv::Mat());
+  const cv::Mat patch_pixel = (patch_labels > 0) & (patch_labels <= num_patches) & has_depth;
+  std::vector<int> role(static_cast<size_t>(total), kNeither);
+  struct Carrier {
+    int i;
+    std::int16_t x, y;
   };
-  std::vector<std::uint8_t> patch_pixel(static_cast<size_t>(total), 0);  // a patch pixel with depth
-  for (int i = 0; i < total; ++i) patch_pixel[static_cast<size_t>(i)] = lab[i] > 0 && lab[i] <= num_patches && valid_point(pts[i]);
-  std::vector<int> slot(static_cast<size_t>(total), -1);  // index into seeds, -1 = patch or no carrier
-  std::vector<int> carriers;
-  for (int y = 0; y < height; ++y)
+  std::vector<Carrier> carriers;
+  for (int y = 0; y < height; ++y) {
+    const uchar* source = patch_pixel.ptr<uchar>(y);
+    const uchar* near = near_depth.ptr<uchar>(y);
+    const int* l = patch_labels.ptr<int>(y);
+    int* row_role = role.data() + static_cast<size_t>(y) * width;
     for (int x = 0; x < width; ++x) {
-      const int i = y * width + x;
-      if (lab[i] != 0 || !(valid_point(pts[i]) || next_to_depth(x, y))) continue;
-      slot[static_cast<size_t>(i)] = static_cast<int>(carriers.size());
-      carriers.push_back(i);
+      if (source[x]) {
+        row_role[x] = kSource;
+      } else if (l[x] == 0 && near[x]) {
+        row_role[x] = static_cast<int>(carriers.size());
+        carriers.push_back({y * width + x, static_cast<std::int16_t>(x), static_cast<std::int16_t>(y)});
+      }
     }
+  }
   std::vector<SeedSet> seeds(carriers.size());
 
   // Two raster passes (forward: from W, NW, N, NE; backward: from E, SE, S, SW), as in a chamfer
   // distance transform: a seed reaches every pixel within r along a path the passes follow.
   const int r2 = r * r;
-  auto gather = [&](int i, const int (&from)[4][2]) {
-    const int x = i % width, y = i / width;
-    const bool has_point = valid_point(pts[i]);
-    SeedSet& own = seeds[static_cast<size_t>(slot[static_cast<size_t>(i)])];
-    const cv::Vec3f here = pts[i];
+  auto gather = [&](const Carrier& c, const int (&from)[4][2]) {
+    const int x = c.x, y = c.y;
+    SeedSet& own = seeds[static_cast<size_t>(role[static_cast<size_t>(c.i)])];
+    const cv::Vec3f* here = valid_point(pts[c.i]) ? &pts[c.i] : nullptr;
     auto offer = [&](const cv::Vec3f& point, int label, int pixel, int sx, int sy) {
       const int dx = sx - x, dy = sy - y;
-      if (dx * dx + dy * dy > r2) return;
-      for (int s = 0; s < own.count; ++s)  // neighbours mostly pass on the same seed
-        if (own.seed[s].pixel == pixel) return;
-      own.offer({point, label, pixel, static_cast<std::int16_t>(sx), static_cast<std::int16_t>(sy),
-                 has_point ? squared_distance(here, point) : static_cast<float>(dx * dx + dy * dy)});
+      if (dx * dx + dy * dy <= r2) own.offer(point, label, pixel, sx, sy, here, dx * dx + dy * dy);
     };
     for (const auto& d : from) {
       const int xx = x + d[0], yy = y + d[1];
       if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
       const int j = yy * width + xx;
-      if (patch_pixel[static_cast<size_t>(j)]) {
+      const int neighbour = role[static_cast<size_t>(j)];
+      if (neighbour == kSource) {
         offer(pts[j], lab[j], j, xx, yy);
-      } else if (slot[static_cast<size_t>(j)] >= 0) {
-        const SeedSet& other = seeds[static_cast<size_t>(slot[static_cast<size_t>(j)])];
+      } else if (neighbour >= 0) {
+        const SeedSet& other = seeds[static_cast<size_t>(neighbour)];
         for (int s = 0; s < other.count; ++s) {
           const Seed& t = other.seed[s];
           offer(t.point, t.label, t.pixel, t.x, t.y);
@@ -134,15 +148,15 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   };
   constexpr int kForward[4][2] = {{-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
   constexpr int kBackward[4][2] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}};
-  for (int i : carriers) gather(i, kForward);
+  for (const Carrier& c : carriers) gather(c, kForward);
   for (auto it = carriers.rbegin(); it != carriers.rend(); ++it) gather(*it, kBackward);
-  const std::vector<int>& reached = carriers;
 
   // The paper's rule on each reached pixel with depth: seeds within d_max.
   int* assigned = out.labels.ptr<int>();
-  for (int i : reached) {
+  for (size_t k = 0; k < carriers.size(); ++k) {
+    const int i = carriers[k].i;
     if (!valid_point(pts[i])) continue;
-    const SeedSet& own = seeds[static_cast<size_t>(slot[static_cast<size_t>(i)])];
+    const SeedSet& own = seeds[k];
     int near[kMaxSeeds], count = 0, best = -1;
     for (int s = 0; s < own.count; ++s) {
       if (own.seed[s].d2 >= d2_max) continue;

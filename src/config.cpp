@@ -20,7 +20,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::GraphCut, theta_c)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Remaining, grow_distance, tiny_px)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Support, objects_only, plane_band, max_height, contact_distance, region_margin, wall_min_extent)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params, smoothing, normals, edges, patches, adjacency, cutfree,
-                                                coplanarity, curvature, graph, remaining, support, seed, threads)
+                                                coplanarity, curvature, graph, remaining, support, seed, threads,
+                                                keep_freed_memory)
 
 namespace {
 // Lists keys of `given` that the defaults do not have (typos would otherwise be ignored silently).

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "clutterseg/occlusion.hpp"
+#include "clutterseg/patches.hpp"
 
 namespace clutterseg {
 
@@ -21,12 +22,6 @@ constexpr size_t kConvexitySamples = 1024;  // pixels used at most for the momen
 constexpr size_t kBinnedSamples = 2048;     // pixels used at most for a patch's peak-bin points
 
 Eigen::Vector3f vec(const cv::Vec3f& v) { return {v[0], v[1], v[2]}; }
-
-// The bin of normal_histogram() (patches.cpp) that a normal falls into.
-int histogram_bin(const cv::Vec3f& n, int bins) {
-  auto bin = [bins](float c) { return std::clamp(static_cast<int>((c + 1.f) * 0.5f * bins), 0, bins - 1); };
-  return bin(n[1]) * bins + bin(n[0]);
-}
 
 int histogram_side(const std::vector<float>& histogram) {
   return static_cast<int>(std::lround(std::sqrt(static_cast<double>(histogram.size()))));
@@ -96,7 +91,7 @@ struct BinnedPixels {
       const int i = patch.pixels[k];
       if (!(pts[i][2] > 0)) continue;
       sampled.push_back(i);
-      bin_of.push_back(histogram_bin(nrm[i], bins));
+      bin_of.push_back(normal_bin(nrm[i], bins));
       ++start[static_cast<size_t>(bin_of.back()) + 1];
     }
     for (size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];

@@ -1,6 +1,8 @@
 #include "clutterseg/patches.hpp"
 
+#include <climits>
 #include <cmath>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 
 namespace clutterseg {
@@ -9,59 +11,93 @@ std::vector<float> normal_histogram(const cv::Mat& normals, const std::vector<in
   std::vector<float> hist(static_cast<size_t>(bins * bins), 0.f);
   if (pixels.empty()) return hist;
   const auto* n = normals.ptr<cv::Vec3f>();
-  auto bin = [bins](float c) { return std::clamp(static_cast<int>((c + 1.f) * 0.5f * bins), 0, bins - 1); };
-  for (int i : pixels) hist[bin(n[i][1]) * bins + bin(n[i][0])] += 1.f;
+  for (int i : pixels) hist[static_cast<size_t>(normal_bin(n[i], bins))] += 1.f;
   const float inv = 1.f / static_cast<float>(pixels.size());
   for (auto& h : hist) h *= inv;
   return hist;
 }
 
+namespace {
+
+// Sums over the pixels of one connected component, gathered run by run in one raster pass.
+struct ComponentSums {
+  int area = 0;
+  int x0 = INT_MAX, y0 = INT_MAX, x1 = -1, y1 = -1;  // bounding box, inclusive
+  double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
+  std::vector<int> pixels;
+  std::vector<int> histogram;  // bins x bins counts
+};
+
+}  // namespace
+
 Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::Mat& normals,
                         const Params::Patches& params, int min_size) {
-  cv::Mat components, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(edges == 0, components, stats, centroids, 4, CV_32S);
+  // OpenCV's labelling without its statistics: the pass below gathers them together with ours
+  // (OpenCV's own statistics pass costs more than the labelling itself).
+  cv::Mat components;
+  const int count = cv::connectedComponents(edges == 0, components, 4, CV_32S);
+  const int bins = params.histogram_bins, cols = edges.cols;
+  std::vector<ComponentSums> sums(static_cast<size_t>(count));
+  for (int y = 0; y < edges.rows; ++y) {
+    const int* comp = components.ptr<int>(y);
+    const auto* pts = points.ptr<cv::Vec3f>(y);
+    const auto* nrm = normals.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < cols;) {
+      // One run of a component along the row: its pixels are contiguous in memory.
+      const int c = comp[x], start = x;
+      while (x < cols && comp[x] == c) ++x;
+      if (c == 0) continue;
+      ComponentSums& s = sums[static_cast<size_t>(c)];
+      if (s.histogram.empty()) s.histogram.assign(static_cast<size_t>(bins * bins), 0);
+      s.area += x - start;
+      s.x0 = std::min(s.x0, start);
+      s.x1 = std::max(s.x1, x - 1);
+      s.y0 = std::min(s.y0, y);
+      s.y1 = y;
+      const size_t first = s.pixels.size();
+      s.pixels.resize(first + static_cast<size_t>(x - start));
+      std::iota(s.pixels.begin() + static_cast<std::ptrdiff_t>(first), s.pixels.end(), y * cols + start);
+      for (int k = start; k < x; ++k) {
+        for (int d = 0; d < 3; ++d) {
+          s.point[d] += pts[k][d];
+          s.normal[d] += nrm[k][d];
+        }
+        ++s.histogram[static_cast<size_t>(normal_bin(nrm[k], bins))];
+      }
+    }
+  }
 
-  // Keep components of at least min_size pixels, numbered 1..N in OpenCV's (raster) order.
+  // Components of at least min_size pixels become patches 1..N, in OpenCV's (raster) order.
   std::vector<int> new_id(static_cast<size_t>(count), 0);
   Patches out;
   for (int c = 1; c < count; ++c) {
-    if (stats.at<int>(c, cv::CC_STAT_AREA) < min_size) continue;
+    ComponentSums& s = sums[static_cast<size_t>(c)];
+    if (s.area < min_size) continue;
     Patch p;
     p.id = static_cast<int>(out.patches.size()) + 1;
-    p.bbox = cv::Rect(stats.at<int>(c, cv::CC_STAT_LEFT), stats.at<int>(c, cv::CC_STAT_TOP),
-                      stats.at<int>(c, cv::CC_STAT_WIDTH), stats.at<int>(c, cv::CC_STAT_HEIGHT));
-    p.pixels.reserve(static_cast<size_t>(stats.at<int>(c, cv::CC_STAT_AREA)));
     new_id[static_cast<size_t>(c)] = p.id;
+    p.bbox = cv::Rect(s.x0, s.y0, s.x1 - s.x0 + 1, s.y1 - s.y0 + 1);
+    const double n = s.area;
+    const Eigen::Vector3d normal_sum(s.normal[0], s.normal[1], s.normal[2]);
+    p.centroid = Eigen::Vector3f(static_cast<float>(s.point[0] / n), static_cast<float>(s.point[1] / n),
+                                 static_cast<float>(s.point[2] / n));
+    p.mean_normal = normal_sum.norm() > 0 ? Eigen::Vector3f(normal_sum.normalized().cast<float>()) : Eigen::Vector3f(0, 0, -1);
+    // Mean angular deviation, taken as the angle of the mean normal's length: |mean of unit normals|
+    // = mean cos(deviation) for small spreads; one acos per patch instead of one per pixel.
+    p.spread_deg = static_cast<float>(std::acos(std::clamp(normal_sum.norm() / n, 0.0, 1.0)) * 180.0 / M_PI);
+    p.histogram.resize(s.histogram.size());
+    for (size_t b = 0; b < s.histogram.size(); ++b) p.histogram[b] = static_cast<float>(s.histogram[b]) * static_cast<float>(1.0 / n);
+    p.occupied_bins = static_cast<int>(std::count_if(p.histogram.begin(), p.histogram.end(),
+        [&](float h) { return h >= params.occupied_share; }));
+    p.curved = p.occupied_bins >= params.flat_max_bins;
+    p.pixels = std::move(s.pixels);
     out.patches.push_back(std::move(p));
   }
   out.labels = cv::Mat(edges.size(), CV_32S);
   const int total = static_cast<int>(edges.total());
   const int* comp = components.ptr<int>();
   int* lab = out.labels.ptr<int>();
-  for (int i = 0; i < total; ++i) {
-    const int id = new_id[static_cast<size_t>(comp[i])];
-    lab[i] = id;
-    if (id) out.patches[static_cast<size_t>(id - 1)].pixels.push_back(i);
-  }
-
-  const auto* pts = points.ptr<cv::Vec3f>();
-  const auto* nrm = normals.ptr<cv::Vec3f>();
-  for (auto& p : out.patches) {
-    Eigen::Vector3d c = Eigen::Vector3d::Zero(), n = Eigen::Vector3d::Zero();
-    for (int i : p.pixels) {
-      c += Eigen::Vector3d(pts[i][0], pts[i][1], pts[i][2]);
-      n += Eigen::Vector3d(nrm[i][0], nrm[i][1], nrm[i][2]);
-    }
-    p.centroid = (c / static_cast<double>(p.pixels.size())).cast<float>();
-    p.mean_normal = n.norm() > 0 ? Eigen::Vector3f(n.normalized().cast<float>()) : Eigen::Vector3f(0, 0, -1);
-    // Mean angular deviation, taken as the angle of the mean normal's length: |mean of unit normals|
-    // = mean cos(deviation) for small spreads; one acos per patch instead of one per pixel.
-    p.spread_deg = static_cast<float>(std::acos(std::clamp(n.norm() / static_cast<double>(p.pixels.size()), 0.0, 1.0)) * 180.0 / M_PI);
-    p.histogram = normal_histogram(normals, p.pixels, params.histogram_bins);
-    p.occupied_bins = static_cast<int>(std::count_if(p.histogram.begin(), p.histogram.end(),
-        [&](float h) { return h >= params.occupied_share; }));
-    p.curved = p.occupied_bins >= params.flat_max_bins;
-  }
+  for (int i = 0; i < total; ++i) lab[i] = new_id[static_cast<size_t>(comp[i])];
   return out;
 }
 

@@ -12,6 +12,11 @@
 #include "clutterseg/remaining.hpp"
 #include "clutterseg/stopwatch.hpp"
 
+#include <mutex>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 namespace clutterseg {
 
 namespace {
@@ -36,7 +41,20 @@ cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
 
 }  // namespace
 
-Segmenter::Segmenter(Params params) : params_(std::move(params)) {}
+void keep_freed_memory() {
+#if defined(__GLIBC__)
+  static std::once_flag once;
+  std::call_once(once, [] {
+    constexpr int kThreshold = 512 << 20;
+    mallopt(M_MMAP_THRESHOLD, kThreshold);
+    mallopt(M_TRIM_THRESHOLD, kThreshold);
+  });
+#endif
+}
+
+Segmenter::Segmenter(Params params) : params_(std::move(params)) {
+  if (params_.keep_freed_memory) keep_freed_memory();
+}
 
 Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   const Params& p = params_;

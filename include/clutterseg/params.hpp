@@ -106,6 +106,7 @@ struct Params {
 
   std::uint64_t seed = 1;        // every random choice is seeded from this
   int threads = 0;               // 0 = all cores (OpenMP); results do not depend on it
+  bool keep_freed_memory = true; // tune glibc malloc to reuse a frame's memory (keep_freed_memory())
 };
 
 // Pixel sizes in Params are for the paper's camera: a 320x240 Kinect v1, fx = fy = 262.5 px. They are

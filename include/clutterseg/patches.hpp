@@ -16,8 +16,12 @@ struct Patches {
 Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::Mat& normals,
                         const Params::Patches& params, int min_size);
 
+// The bin of a unit normal in the (x, y) histogram of normals: bins x bins cells over [-1, 1]^2.
+inline int normal_bin(const cv::Vec3f& n, int bins) {
+  auto bin = [bins](float c) { return std::clamp(static_cast<int>((c + 1.f) * 0.5f * bins), 0, bins - 1); };
+  return bin(n[1]) * bins + bin(n[0]);
+}
+
 // Normal (x, y) histogram of the given pixels: bins x bins shares summing to 1.
 std::vector<float> normal_histogram(const cv::Mat& normals, const std::vector<int>& pixels, int bins);
-
-
 }  // namespace clutterseg

@@ -45,6 +45,14 @@ class Segmenter {
   TemporalSmoother temporal_;
 };
 
+// A frame allocates some 40 MB of images and scratch at 640x480. By default glibc hands blocks that
+// large back to the kernel when they are freed (mmap, heap trimming), so every frame faults its memory
+// in again page by page: a quarter of the pre-segmentation's time. This raises glibc's mmap and trim
+// thresholds to 512 MB, once per process, so freed memory is reused by the next frame; the process keeps
+// its peak heap. Called by Segmenter's constructor unless Params::keep_freed_memory is false; a no-op
+// without glibc.
+void keep_freed_memory();
+
 // One frame, no temporal history.
 Result segment(const cv::Mat& depth, const Camera& camera, const Params& params = {});
 
