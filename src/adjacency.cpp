@@ -28,36 +28,39 @@ bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
 // Seeds kept per pixel: one per patch, the nearest kMaxSeeds patches.
 constexpr int kMaxSeeds = 4;
 
+// A seed is a patch pixel, named by its image position; its point and label are read from the images
+// when needed (they lie within r pixels, so in cache). 12 bytes: the seed sets of all carriers of a
+// 640x480 frame fit in 5 MB.
 struct Seed {
-  cv::Vec3f point;    // the patch pixel's 3D point (carried along: no random reads of the cloud)
-  float d2;           // squared 3D distance to the pixel holding it; for a pixel without depth, the squared
-                      // image distance instead (it only relays, keeping the seeds nearest in the image)
-  int label;          // patch id 1..N
-  int pixel;          // linear index of the patch pixel
-  std::int16_t x, y;  // its image position (no division in the inner loop)
+  std::uint32_t yx;  // (y << 16) | x: one compare tells two seeds apart, and orders them as pixel indices
+  int label;         // patch id 1..N
+  float d2;          // squared 3D distance to the pixel holding it; for a pixel without depth, the squared
+                     // image distance instead (it only relays, keeping the seeds nearest in the image)
 };
 
-// Strict order on seeds competing for one slot: nearer first, ties to the smaller pixel index (or
-// label), so that the result does not depend on the order neighbours are visited.
-bool nearer(const Seed& a, const Seed& b) { return a.d2 < b.d2 || (a.d2 == b.d2 && a.pixel < b.pixel); }
+std::uint32_t pack(int x, int y) { return static_cast<std::uint32_t>(y) << 16 | static_cast<std::uint32_t>(x); }
+
+// Strict order on seeds competing for one slot: nearer first, ties to the smaller pixel index, so that
+// the result does not depend on the order neighbours are visited.
+bool nearer(const Seed& a, const Seed& b) { return a.d2 < b.d2 || (a.d2 == b.d2 && a.yx < b.yx); }
 
 struct SeedSet {
   Seed seed[kMaxSeeds];
-  int count = 0;
-  // Offers the seed of patch pixel `from` (at image distance^2 `image_d2`) to the pixel at `here`:
-  // keeps the nearest seed per label and the kMaxSeeds nearest labels. Neighbours mostly pass on a seed
-  // this set already holds, so that case returns before any distance is computed.
-  void offer(const cv::Vec3f& point, int label, int pixel, int x, int y, const cv::Vec3f* here, int image_d2) {
+  int count;
+  SeedSet() : count(0) {}  // user-provided: a vector of SeedSets is not zero-filled first
+  // Offers a seed: keeps the nearest seed per label and the kMaxSeeds nearest labels. Neighbours mostly
+  // pass on a seed this set already holds; that case returns before any distance is computed.
+  // `distance2` gives d2 for the candidate.
+  template <typename Distance2>
+  void offer(std::uint32_t yx, int label, Distance2 distance2) {
     int slot = -1;
     for (int i = 0; i < count; ++i)
       if (seed[i].label == label) {
-        if (seed[i].pixel == pixel) return;
+        if (seed[i].yx == yx) return;
         slot = i;
         break;
       }
-    const cv::Vec3f d = here ? point - *here : cv::Vec3f();
-    const Seed s{point, here ? d.dot(d) : static_cast<float>(image_d2), label, pixel,
-                 static_cast<std::int16_t>(x), static_cast<std::int16_t>(y)};
+    const Seed s{yx, label, distance2()};
     if (slot >= 0) {
       if (nearer(s, seed[slot])) seed[slot] = s;
       return;
@@ -69,7 +72,6 @@ struct SeedSet {
     if (s.d2 < seed[worst].d2 || (s.d2 == seed[worst].d2 && s.label < seed[worst].label)) seed[worst] = s;
   }
 };
-
 
 }  // namespace
 
@@ -125,10 +127,16 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   auto gather = [&](const Carrier& c, const int (&from)[4][2]) {
     const int x = c.x, y = c.y;
     SeedSet& own = seeds[static_cast<size_t>(role[static_cast<size_t>(c.i)])];
-    const cv::Vec3f* here = valid_point(pts[c.i]) ? &pts[c.i] : nullptr;
-    auto offer = [&](const cv::Vec3f& point, int label, int pixel, int sx, int sy) {
+    const cv::Vec3f here = pts[c.i];
+    const bool has_point = valid_point(here);
+    auto offer = [&](int sx, int sy, int label) {
       const int dx = sx - x, dy = sy - y;
-      if (dx * dx + dy * dy <= r2) own.offer(point, label, pixel, sx, sy, here, dx * dx + dy * dy);
+      if (dx * dx + dy * dy > r2) return;
+      own.offer(pack(sx, sy), label, [&] {
+        if (!has_point) return static_cast<float>(dx * dx + dy * dy);
+        const cv::Vec3f d = pts[sy * width + sx] - here;
+        return d.dot(d);
+      });
     };
     for (const auto& d : from) {
       const int xx = x + d[0], yy = y + d[1];
@@ -136,12 +144,12 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
       const int j = yy * width + xx;
       const int neighbour = role[static_cast<size_t>(j)];
       if (neighbour == kSource) {
-        offer(pts[j], lab[j], j, xx, yy);
+        offer(xx, yy, lab[j]);
       } else if (neighbour >= 0) {
         const SeedSet& other = seeds[static_cast<size_t>(neighbour)];
         for (int s = 0; s < other.count; ++s) {
           const Seed& t = other.seed[s];
-          offer(t.point, t.label, t.pixel, t.x, t.y);
+          offer(static_cast<int>(t.yx & 0xffff), static_cast<int>(t.yx >> 16), t.label);
         }
       }
     }
