@@ -23,35 +23,44 @@ cv::Mat depth_to_metres(const cv::Mat& depth, const Camera& camera) {
   return out;
 }
 
+namespace {
+
+// Median of the valid (> 0) values among the 3x3 neighbours of (x, y), for a pixel next to a hole or
+// the image border (insertion sort: at most 8 values).
+float median_of_valid_neighbours(const cv::Mat& depth, int x, int y) {
+  float v[9];
+  int n = 0;
+  for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, depth.rows - 1); ++yy) {
+    const float* row = depth.ptr<float>(yy);
+    for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, depth.cols - 1); ++xx) {
+      float z = row[xx];
+      if (!(z > 0)) continue;
+      int k = n++;
+      for (; k > 0 && v[k - 1] > z; --k) v[k] = v[k - 1];
+      v[k] = z;
+    }
+  }
+  return v[n / 2];  // n >= 1: the pixel itself is valid
+}
+
+}  // namespace
+
 cv::Mat median_depth(const cv::Mat& depth) {
-  // OpenCV's median (SIMD) for the bulk; pixels next to a hole are redone over valid neighbours only,
-  // so that missing data neither spreads nor drags a surface towards zero.
+  // OpenCV's median (SIMD) for the bulk. Pixels within one pixel of a hole or of the image border
+  // (OpenCV replicates the border) are redone over their valid neighbours only, so that missing data
+  // neither spreads nor drags a surface towards zero; holes stay holes.
   cv::Mat out;
   cv::medianBlur(depth, out, 3);
-  // Pixels within one pixel of a hole (found with an erosion of the valid mask) are redone over their
-  // valid neighbours only; OpenCV's median replicates the border, so border pixels are redone too.
-  cv::Mat valid = depth > 0, redo;
-  cv::erode(valid, redo, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-  redo = valid & ~redo;
-  const int rows = depth.rows, cols = depth.cols;
-  parallel_for_rows(rows, [&](int begin, int end) {
-    float v[9];
+  cv::Mat valid = depth > 0, inner;
+  cv::erode(valid, inner, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  parallel_for_rows(depth.rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y) {
       float* o = out.ptr<float>(y);
-      const uchar* r = redo.ptr<uchar>(y);
       const uchar* ok = valid.ptr<uchar>(y);
-      for (int x = 0; x < cols; ++x) {
-        if (!ok[x]) { o[x] = 0; continue; }
-        if (!r[x]) continue;
-        int n = 0;
-        for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, rows - 1); ++yy)
-          for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, cols - 1); ++xx) {
-            const float z = depth.ptr<float>(yy)[xx];
-            if (z > 0) v[n++] = z;
-          }
-        std::nth_element(v, v + n / 2, v + n);
-        o[x] = v[n / 2];
-      }
+      const uchar* far_from_hole = inner.ptr<uchar>(y);
+      for (int x = 0; x < depth.cols; ++x)
+        if (!ok[x]) o[x] = 0;
+        else if (!far_from_hole[x]) o[x] = median_of_valid_neighbours(depth, x, y);
     }
   });
   return out;
@@ -68,6 +77,12 @@ CLUTTERSEG_ROW_KERNEL void accumulate_within_band(const float* __restrict v, con
     sum[x] += take ? v[x] : 0.f;
     count[x] += take ? 1.f : 0.f;
   }
+}
+
+// mean = sum / count where the newest frame has a measurement, else 0.
+CLUTTERSEG_ROW_KERNEL void mean_where_measured(const float* __restrict newest, const float* __restrict sum,
+                                               const float* __restrict count, int cols, float* __restrict mean) {
+  for (int x = 0; x < cols; ++x) mean[x] = newest[x] > 0 ? sum[x] / std::max(count[x], 1.f) : 0.f;
 }
 
 }  // namespace
@@ -99,8 +114,7 @@ cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& pa
         for (int i = 0; i < n; ++i)
           accumulate_within_band(frames[static_cast<size_t>(i)]->ptr<float>(y), around, depth.cols, band_k, sum.data(),
                                  count.data());
-        float* mean = pass == 0 ? centre.data() : o;
-        for (size_t x = 0; x < cols; ++x) mean[x] = newest[x] > 0 ? sum[x] / std::max(count[x], 1.f) : 0.f;
+        mean_where_measured(newest, sum.data(), count.data(), depth.cols, pass == 0 ? centre.data() : o);
       }
     }
   });
