@@ -1,6 +1,8 @@
 #include "clutterseg/edges.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <opencv2/core.hpp>
 
 #include "clutterseg/parallel.hpp"
 
@@ -18,28 +20,37 @@ CLUTTERSEG_ROW_KERNEL void add_abs_dot(const float* __restrict nx, const float* 
   for (int x = 0; x < count; ++x) v[x] += std::abs(nx[x] * qx[x] + ny[x] * qy[x] + nz[x] * qz[x]);
 }
 
-// big[x] = max(big[x], |q[x] - z[x]|) where q[x] is a measurement.
-CLUTTERSEG_ROW_KERNEL void max_jump(const float* __restrict z, const float* __restrict q, int count,
-                                    float* __restrict big) {
-  for (int x = 0; x < count; ++x) big[x] = std::max(big[x], q[x] > 0 ? std::abs(q[x] - z[x]) : 0.f);
-}
+// |q - z| where q is a measurement, else 0.
+inline float jump(float q, float z) { return q > 0 ? std::abs(q - z) : 0.f; }
 
-CLUTTERSEG_ROW_KERNEL void binarize(const float* __restrict z, const float* __restrict v,
-                                    const float* __restrict big, int cols, float theta, float jump_limit,
-                                    uchar* __restrict e) {
-  for (int x = 0; x < cols; ++x)
-    e[x] = static_cast<uchar>(((z[x] <= 0) | (v[x] < theta) | (big[x] > jump_limit * z[x])) * 255);
+// One row of the edge mask: an edge where there is no measurement, where the
+// normal-edge value is below theta, or where a depth jump to one of the 8 adjacent pixels is larger
+// than jump_limit * z. Rows `up` and `down` are the rows above and below (the row itself at the image
+// border, which makes no jump).
+CLUTTERSEG_ROW_KERNEL void edge_row(const float* __restrict up, const float* __restrict z,
+                                    const float* __restrict down, const float* __restrict value, int cols,
+                                    float theta, float jump_limit, uchar* __restrict e) {
+  for (int x = 0; x < cols; ++x) {
+    const float c = z[x];
+    const float largest = std::max({jump(up[x - 1], c), jump(up[x], c), jump(up[x + 1], c), jump(z[x - 1], c),
+                                    jump(z[x + 1], c), jump(down[x - 1], c), jump(down[x], c), jump(down[x + 1], c)});
+    e[x] = static_cast<uchar>(((c <= 0) | (value[x] < theta) | (largest > jump_limit * c)) * 255);
+  }
 }
 
 }  // namespace
 
 cv::Mat normal_edge_value(const cv::Mat& normals, int step) {
-  const int rows = normals.rows, cols = normals.cols;
-  // Planar copies make the inner loops plain float arrays. A missing normal is (0,0,0), so it
-  // contributes 0 to its neighbours' mean and gets 0 itself, without a branch.
-  cv::Mat n[3];
-  cv::split(normals, n);
-  cv::Mat value(normals.size(), CV_32F, cv::Scalar(0));
+  NormalPlanes planes;
+  cv::split(normals, planes.data());
+  return normal_edge_value(planes, step);
+}
+
+cv::Mat normal_edge_value(const NormalPlanes& n, int step) {
+  // Planes make the inner loops plain float arrays. A missing normal is (0,0,0), so it contributes 0
+  // to its neighbours' mean and gets 0 itself, without a branch.
+  const int rows = n[0].rows, cols = n[0].cols;
+  cv::Mat value(n[0].size(), CV_32F, cv::Scalar(0));
   parallel_for_rows(rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y) {
       float* v = value.ptr<float>(y);
@@ -77,22 +88,15 @@ cv::Mat normal_edge_value(const cv::Mat& normals, int step) {
 cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& depth, double theta, float jump_limit) {
   const int rows = depth.rows, cols = depth.cols;
   cv::Mat edges(depth.size(), CV_8U);
+  // One column of replicated depth on each side: a pixel outside the image makes no jump.
+  cv::Mat padded;
+  cv::copyMakeBorder(depth, padded, 0, 0, 1, 1, cv::BORDER_REPLICATE);
   parallel_for_rows(rows, [&](int begin, int end) {
-    std::vector<float> largest(static_cast<size_t>(cols));
     for (int y = begin; y < end; ++y) {
-      const float* z = depth.ptr<float>(y);
-      // Largest depth difference to a valid adjacent pixel (8 directions; outside the image skipped).
-      std::fill(largest.begin(), largest.end(), 0.f);
-      for (int dy = -1; dy <= 1; ++dy) {
-        if (y + dy < 0 || y + dy >= rows) continue;
-        const float* q = depth.ptr<float>(y + dy);
-        for (int dx = -1; dx <= 1; ++dx) {
-          if (dx == 0 && dy == 0) continue;
-          const int xb = std::max(0, -dx), xe = cols - std::max(0, dx);
-          max_jump(z + xb, q + xb + dx, xe - xb, largest.data() + xb);
-        }
-      }
-      binarize(z, edge_value.ptr<float>(y), largest.data(), cols, static_cast<float>(theta), jump_limit, edges.ptr<uchar>(y));
+      const float* z = padded.ptr<float>(y) + 1;
+      const float* up = y > 0 ? padded.ptr<float>(y - 1) + 1 : z;
+      const float* down = y + 1 < rows ? padded.ptr<float>(y + 1) + 1 : z;
+      edge_row(up, z, down, edge_value.ptr<float>(y), cols, static_cast<float>(theta), jump_limit, edges.ptr<uchar>(y));
     }
   });
   return edges;

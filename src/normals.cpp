@@ -77,7 +77,7 @@ CLUTTERSEG_ROW_KERNEL void normalize_row(const float* __restrict z, int cols, fl
 
 }  // namespace
 
-cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit) {
+NormalPlanes compute_normal_planes(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit) {
   const int rows = depth.rows, cols = depth.cols, s = step;
   // Zero padding: a neighbour outside the image is "no measurement", like a hole.
   cv::Mat padded;
@@ -86,7 +86,7 @@ cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, in
   for (int u = 0; u < cols + 2 * s; ++u) ray_x[static_cast<size_t>(u)] = static_cast<float>((u - s - camera.cx) / camera.fx);
   const auto ray_y = [&](int v) { return static_cast<float>((v - camera.cy) / camera.fy); };
 
-  cv::Mat planes[3] = {cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F)};
+  NormalPlanes planes = {cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F)};
   parallel_for_rows(rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
       raw_normal_row(padded.ptr<float>(y) + s, padded.ptr<float>(y + s) + s, padded.ptr<float>(y + 2 * s) + s,
@@ -99,8 +99,13 @@ cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, in
     for (int y = begin; y < end; ++y)
       normalize_row(depth.ptr<float>(y), cols, planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
   });
+  return planes;
+}
+
+cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit) {
+  const NormalPlanes planes = compute_normal_planes(depth, camera, step, ksize, jump_limit);
   cv::Mat normals;
-  cv::merge(planes, 3, normals);
+  cv::merge(planes.data(), 3, normals);
   return normals;
 }
 

@@ -1,6 +1,7 @@
 // Paper b): surface-normal edges.
 #pragma once
 
+#include "clutterseg/normals.hpp"
 #include "clutterseg/params.hpp"
 #include "clutterseg/types.hpp"
 
@@ -9,6 +10,7 @@ namespace clutterseg {
 // Mean over the 8 neighbour directions (at distance `step`) of |n(p) . n(q)|; 1 on flat surfaces,
 // smaller at creases. Pixels without a normal get 0; neighbours without a normal count as 0.
 cv::Mat normal_edge_value(const cv::Mat& normals, int step);
+cv::Mat normal_edge_value(const NormalPlanes& normals, int step);  // the same on planar normals
 
 // Binary edge image (CV_8U, 255 = edge) from the edge value and the depth (CV_32F metres): edge value
 // below theta, no measurement, or a depth jump

@@ -1,6 +1,8 @@
 // Paper a): organized 3D points and per-pixel surface normals.
 #pragma once
 
+#include <array>
+
 #include "clutterseg/params.hpp"
 #include "clutterseg/types.hpp"
 
@@ -18,6 +20,11 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
 // discontinuity (jump_limit, relative to z) falls back to the one-sided difference. step and ksize are
 // the scaled values (PixelScale).
 cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit);
+
+// The same normals as three CV_32F planes (x, y, z), the layout the edge stage reads (no interleave
+// and split in between).
+using NormalPlanes = std::array<cv::Mat, 3>;
+NormalPlanes compute_normal_planes(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit);
 
 
 }  // namespace clutterseg
