@@ -12,12 +12,30 @@ namespace {
 
 constexpr int kDirs[8][2] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
 
-// v[x] += |n(x) . q(x)| over x in [0, count): one neighbour direction of a row.
-CLUTTERSEG_ROW_KERNEL void add_abs_dot(const float* __restrict nx, const float* __restrict ny,
-                                       const float* __restrict nz, const float* __restrict qx,
-                                       const float* __restrict qy, const float* __restrict qz, int count,
-                                       float* __restrict v) {
-  for (int x = 0; x < count; ++x) v[x] += std::abs(nx[x] * qx[x] + ny[x] * qy[x] + nz[x] * qz[x]);
+// One row of the edge value away from the image border, columns [x0, x1): the mean over the 8
+// neighbours `s` pixels away of |n . n_q|. Normals come as planes (x, y, z) of the rows y - s, y, y + s.
+CLUTTERSEG_ROW_KERNEL void edge_value_row(const float* __restrict ux, const float* __restrict uy,
+                                          const float* __restrict uz, const float* __restrict mx,
+                                          const float* __restrict my, const float* __restrict mz,
+                                          const float* __restrict dx, const float* __restrict dy,
+                                          const float* __restrict dz, int s, int x0, int x1, float* __restrict v) {
+  for (int x = x0; x < x1; ++x) {
+    const float a = mx[x], b = my[x], c = mz[x];
+    auto cosine = [&](const float* qx, const float* qy, const float* qz, int q) {
+      return std::abs(a * qx[q] + b * qy[q] + c * qz[q]);
+    };
+    // In the order of kDirs (the border code below), so both give the same bits.
+    float sum = 0;
+    sum += cosine(ux, uy, uz, x - s);
+    sum += cosine(ux, uy, uz, x);
+    sum += cosine(ux, uy, uz, x + s);
+    sum += cosine(mx, my, mz, x - s);
+    sum += cosine(mx, my, mz, x + s);
+    sum += cosine(dx, dy, dz, x - s);
+    sum += cosine(dx, dy, dz, x);
+    sum += cosine(dx, dy, dz, x + s);
+    v[x] = sum * 0.125f;
+  }
 }
 
 // |q - z| where q is a measurement, else 0.
@@ -56,15 +74,10 @@ cv::Mat normal_edge_value(const NormalPlanes& n, int step) {
       float* v = value.ptr<float>(y);
       const bool inner_row = y >= step && y + step < rows;
       const int x0 = inner_row ? step : cols, x1 = inner_row ? cols - step : cols;
-      if (inner_row) {
-        for (const auto& d : kDirs) {
-          const int yy = y + d[1] * step, dx = d[0] * step;
-          add_abs_dot(n[0].ptr<float>(y) + x0, n[1].ptr<float>(y) + x0, n[2].ptr<float>(y) + x0,
-                      n[0].ptr<float>(yy) + x0 + dx, n[1].ptr<float>(yy) + x0 + dx, n[2].ptr<float>(yy) + x0 + dx,
-                      x1 - x0, v + x0);
-        }
-        for (int x = x0; x < x1; ++x) v[x] *= 0.125f;
-      }
+      if (inner_row)
+        edge_value_row(n[0].ptr<float>(y - step), n[1].ptr<float>(y - step), n[2].ptr<float>(y - step),
+                       n[0].ptr<float>(y), n[1].ptr<float>(y), n[2].ptr<float>(y), n[0].ptr<float>(y + step),
+                       n[1].ptr<float>(y + step), n[2].ptr<float>(y + step), step, x0, x1, v);
       // Image border: the mean over the neighbours that lie inside the image.
       for (int x = 0; x < cols; ++x) {
         if (x == x0) x = x1;
