@@ -21,6 +21,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 namespace clutterseg {
 
@@ -29,7 +30,7 @@ namespace {
 bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
 
 struct Segment {
-  std::vector<int> pixels;
+  size_t begin, end;  // its pixels in the list of all segments' pixels
   cv::Rect bbox;
 };
 
@@ -95,55 +96,64 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   for (int o : object_of_patch)
     if (o < 0 || o >= num_objects) throw Error("assign_remaining: object index out of range");
 
-  cv::Mat objects(assigned_labels.size(), CV_32S, cv::Scalar(0));
+  // Object id of every patch label (index 0: no patch).
+  std::vector<int> object_of_label(static_cast<size_t>(num_patches) + 1, 0);
+  for (int p = 0; p < num_patches; ++p) object_of_label[static_cast<size_t>(p) + 1] = object_of_patch[static_cast<size_t>(p)] + 1;
+  cv::Mat objects(assigned_labels.size(), CV_32S);
   int* obj = objects.ptr<int>();
+  // Remaining pixels (no patch, valid) are marked once, so the growing below reads one byte per pixel.
+  constexpr uchar kRemaining = 1, kGrown = 2;
+  std::vector<uchar> state(static_cast<size_t>(total), 0);
   for (int i = 0; i < total; ++i) {
     if (lab[i] > num_patches) throw Error("assign_remaining: patch label out of range");
-    if (lab[i] > 0) obj[i] = object_of_patch[static_cast<size_t>(lab[i] - 1)] + 1;
+    obj[i] = lab[i] > 0 ? object_of_label[static_cast<size_t>(lab[i])] : 0;
+    state[static_cast<size_t>(i)] = lab[i] == 0 && valid_point(pts[i]) ? kRemaining : 0;
   }
 
-  // Region growing of the unassigned valid pixels; segment_of = index + 1, 0 = not remaining.
+  // Region growing of the remaining pixels; segment_of = index + 1, 0 = not remaining. The pixels of
+  // all segments are stored one after another: segment s is pixels[begin[s], begin[s + 1]).
   std::vector<int> segment_of(static_cast<size_t>(total), 0);
   std::vector<Segment> segments;
   const float grow2 = static_cast<float>(params.grow_distance * params.grow_distance);
-  std::vector<int> queue;
+  std::vector<int> pixels;
   for (int seed_px = 0; seed_px < total; ++seed_px) {
-    if (lab[seed_px] != 0 || segment_of[static_cast<size_t>(seed_px)] || !valid_point(pts[seed_px])) continue;
-    Segment s;
+    if (state[static_cast<size_t>(seed_px)] != kRemaining) continue;
     const int id = static_cast<int>(segments.size()) + 1;
-    queue.assign(1, seed_px);
+    const size_t begin = pixels.size();
+    pixels.push_back(seed_px);
+    state[static_cast<size_t>(seed_px)] = kGrown;
     segment_of[static_cast<size_t>(seed_px)] = id;
     int x0 = width, y0 = height, x1 = -1, y1 = -1;
-    for (size_t head = 0; head < queue.size(); ++head) {  // every pixel enters once: bounded
-      const int i = queue[head];
+    for (size_t head = begin; head < pixels.size(); ++head) {  // every pixel enters once: bounded
+      const int i = pixels[head];
       const int x = i % width, y = i / width;
       x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
       for (int k = 0; k < 8; ++k) {
         const int xx = x + kDx[k], yy = y + kDy[k];
         if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
         const int j = yy * width + xx;
-        if (lab[j] != 0 || segment_of[static_cast<size_t>(j)] || !valid_point(pts[j])) continue;
+        if (state[static_cast<size_t>(j)] != kRemaining) continue;
         const cv::Vec3f d = pts[i] - pts[j];
         if (d.dot(d) >= grow2) continue;
+        state[static_cast<size_t>(j)] = kGrown;
         segment_of[static_cast<size_t>(j)] = id;
-        queue.push_back(j);
+        pixels.push_back(j);
       }
     }
-    s.pixels = queue;
-    s.bbox = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
-    segments.push_back(std::move(s));
+    segments.push_back({begin, pixels.size(), cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1)});
   }
 
   std::vector<int> ring_stamp(static_cast<size_t>(total), 0);  // last segment that counted this pixel
   int next_object = num_objects;
   for (size_t s = 0; s < segments.size(); ++s) {
     const Segment& seg = segments[s];
+    const std::span<const int> seg_pixels(pixels.data() + seg.begin, seg.end - seg.begin);
     const int id = static_cast<int>(s) + 1;
     // The ring: pixels 8-adjacent to the segment, each counted once.
     bool touches_border = false;
     int other_segment = 0, invalid = 0;
     std::vector<std::pair<int, int>> faces;  // (patch label, ring pixels)
-    for (int i : seg.pixels) {
+    for (int i : seg_pixels) {
       const int x = i % width, y = i / width;
       for (int k = 0; k < 8; ++k) {
         const int xx = x + kDx[k], yy = y + kDy[k];
@@ -162,16 +172,16 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       }
     }
     std::sort(faces.begin(), faces.end());  // by label: independent of the scan order
-    auto set_all = [&](int object_id) { for (int i : seg.pixels) obj[i] = object_id; };
+    auto set_all = [&](int object_id) { for (int i : seg_pixels) obj[i] = object_id; };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
 
     if (faces.empty()) {                                              // rule 1
       // A tiny segment alone is sensor noise (stereo sensors leave thousands of them), not an object.
-      if (static_cast<int>(seg.pixels.size()) >= tiny_px) set_all(++next_object);
+      if (static_cast<int>(seg_pixels.size()) >= tiny_px) set_all(++next_object);
       continue;
     }
     if (faces.size() == 1) {
-      const bool tiny = static_cast<int>(seg.pixels.size()) < tiny_px;          // rule 2
+      const bool tiny = static_cast<int>(seg_pixels.size()) < tiny_px;          // rule 2
       const bool enclosed = !touches_border && other_segment == 0 && faces[0].second >= invalid;  // rule 3
       set_all(!tiny && enclosed ? ++next_object : object_of(faces[0].first));
       continue;
@@ -192,7 +202,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       set_all(object_of(best->first));
       continue;
     }
-    for (int i : seg.pixels) {
+    for (int i : seg_pixels) {
       const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
       float best = std::numeric_limits<float>::infinity();
       for (const auto& [plane, object_id] : planes) {
