@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
@@ -58,6 +59,77 @@ struct PlaneRegion {
   }
 };
 
+// cv::convexHull of plane points. It sorts every point (~0.4 ms for the 4000 of a table); points more
+// than 1 mm inside the polygon of the extreme points in 8 directions cannot be hull vertices, so
+// dropping them first gives the same hull.
+std::vector<cv::Point2f> convex_hull(const std::vector<cv::Point2f>& points) {
+  // Extreme points along x, y, x + y and x - y (one pass), in counter-clockwise order of direction.
+  std::array<cv::Point2f, 8> extreme;
+  extreme.fill(points.front());
+  auto along = [](const cv::Point2f& p, int k) {  // projection on direction k * 45 degrees (unnormalised)
+    constexpr float kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1}, kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+    return kDx[k] * p.x + kDy[k] * p.y;
+  };
+  for (const cv::Point2f& p : points)
+    for (int k = 0; k < 8; ++k)
+      if (along(p, k) > along(extreme[static_cast<size_t>(k)], k)) extreme[static_cast<size_t>(k)] = p;
+  std::vector<cv::Point2f> polygon;
+  for (const cv::Point2f& e : extreme)
+    if (polygon.empty() || e != polygon.back()) polygon.push_back(e);
+  if (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
+  // Edges as lines n . p = offset with unit normal n pointing inwards (left of the edge).
+  std::vector<cv::Vec3f> edges;
+  for (size_t k = 0; polygon.size() >= 3 && k < polygon.size(); ++k) {
+    const cv::Point2f edge = polygon[(k + 1) % polygon.size()] - polygon[k];
+    const cv::Point2f n = cv::Point2f(-edge.y, edge.x) / std::hypot(edge.x, edge.y);
+    edges.emplace_back(n.x, n.y, n.dot(polygon[k]));
+  }
+  constexpr float kMargin = 0.001f;  // [m], far above the float rounding of plane coordinates
+  std::vector<cv::Point2f> outer;
+  for (const cv::Point2f& p : points) {
+    bool inside = !edges.empty();
+    for (const cv::Vec3f& e : edges) inside &= e[0] * p.x + e[1] * p.y > e[2] + kMargin;
+    if (!inside) outer.push_back(p);
+  }
+  std::vector<cv::Point2f> hull;
+  cv::convexHull(outer, hull);
+  return hull;
+}
+
+// Dilation of `cells` by `kernel` (each kernel row a single span of ones, as in an elliptic kernel);
+// the same cells as cv::dilate, which costs ~1 ms on a table-sized region, by painting for every run of
+// set cells the span each kernel row spreads it to (a filled convex polygon has one run per row).
+cv::Mat dilate_by_spans(const cv::Mat& cells, const cv::Mat& kernel) {
+  const cv::Point anchor(kernel.cols / 2, kernel.rows / 2);  // cv::dilate's default anchor
+  std::vector<std::pair<int, int>> span;  // first and last column of ones in each kernel row
+  for (int j = 0; j < kernel.rows; ++j) {
+    const uchar* k = kernel.ptr<uchar>(j);
+    int first = 0, last = kernel.cols - 1;
+    while (first < kernel.cols && !k[first]) ++first;
+    while (last >= first && !k[last]) --last;
+    span.emplace_back(first, last);
+  }
+  cv::Mat out(cells.size(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < cells.rows; ++y) {
+    const uchar* row = cells.ptr<uchar>(y);
+    for (int left = 0; left < cells.cols; ++left) {
+      if (!row[left]) continue;
+      int right = left;
+      while (right + 1 < cells.cols && row[right + 1]) ++right;
+      // dst(x, y) = max over kernel cells (i, j) of src(x + i - anchor.x, y + j - anchor.y).
+      for (int j = 0; j < kernel.rows; ++j) {
+        const auto [first, last] = span[static_cast<size_t>(j)];
+        const int to_y = y - j + anchor.y;
+        if (last < first || to_y < 0 || to_y >= out.rows) continue;
+        const int x0 = std::max(0, left - last + anchor.x), x1 = std::min(out.cols - 1, right - first + anchor.x);
+        if (x0 <= x1) std::memset(out.ptr<uchar>(to_y) + x0, 255, static_cast<size_t>(x1 - x0 + 1));
+      }
+      left = right;
+    }
+  }
+  return out;
+}
+
 PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin) {
   PlaneRegion r;
   r.plane = plane;
@@ -72,8 +144,7 @@ PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const 
       projected.emplace_back(r.u.dot(q), r.v.dot(q));
     }
   if (projected.size() < 3) return r;
-  std::vector<cv::Point2f> hull;
-  cv::convexHull(projected, hull);
+  const std::vector<cv::Point2f> hull = convex_hull(projected);
   cv::Rect2f box(hull[0], hull[0]);
   for (const auto& h : hull) {
     const float x1 = std::max(box.x + box.width, h.x), y1 = std::max(box.y + box.height, h.y);
@@ -93,7 +164,7 @@ PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const 
     poly.emplace_back(static_cast<int>(std::lround((h.x - r.origin.x) / PlaneRegion::kCell)),
                       static_cast<int>(std::lround((h.y - r.origin.y) / PlaneRegion::kCell)));
   cv::fillConvexPoly(r.cells, poly, cv::Scalar(255));
-  if (pad > 1) cv::dilate(r.cells, r.cells, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * pad - 1, 2 * pad - 1}));
+  if (pad > 1) r.cells = dilate_by_spans(r.cells, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * pad - 1, 2 * pad - 1}));
   return r;
 }
 
