@@ -21,6 +21,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <span>
 
 namespace clutterseg {
@@ -33,6 +35,16 @@ struct Segment {
   size_t begin, end;  // its pixels in the list of all segments' pixels
   cv::Rect bbox;
 };
+
+// States of a pixel during the growing.
+constexpr uchar kRemaining = 1, kGrown = 2;
+
+// The first pixel at or after `from` still to grow (state.size() if none). memchr: the remaining pixels
+// are few and scattered, and it scans many bytes per step.
+int next_remaining(const std::vector<uchar>& state, int from) {
+  const auto* found = static_cast<const uchar*>(std::memchr(state.data() + from, kRemaining, state.size() - static_cast<size_t>(from)));
+  return static_cast<int>(found ? found - state.data() : static_cast<std::ptrdiff_t>(state.size()));
+}
 
 constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
 constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
@@ -99,25 +111,29 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   // Object id of every patch label (index 0: no patch).
   std::vector<int> object_of_label(static_cast<size_t>(num_patches) + 1, 0);
   for (int p = 0; p < num_patches; ++p) object_of_label[static_cast<size_t>(p) + 1] = object_of_patch[static_cast<size_t>(p)] + 1;
+  double max_label = 0;
+  cv::minMaxLoc(assigned_labels, nullptr, &max_label);
+  if (max_label > num_patches) throw Error("assign_remaining: patch label out of range");
   cv::Mat objects(assigned_labels.size(), CV_32S);
   int* obj = objects.ptr<int>();
   // Remaining pixels (no patch, valid) are marked once, so the growing below reads one byte per pixel.
-  constexpr uchar kRemaining = 1, kGrown = 2;
   std::vector<uchar> state(static_cast<size_t>(total), 0);
-  for (int i = 0; i < total; ++i) {
-    if (lab[i] > num_patches) throw Error("assign_remaining: patch label out of range");
-    obj[i] = lab[i] > 0 ? object_of_label[static_cast<size_t>(lab[i])] : 0;
-    state[static_cast<size_t>(i)] = lab[i] == 0 && valid_point(pts[i]) ? kRemaining : 0;
+  size_t num_remaining = 0;
+  for (int i = 0; i < total; ++i) {  // branch-free (& not &&): labels and depth are noisy at edges
+    obj[i] = object_of_label[static_cast<size_t>(std::max(lab[i], 0))];
+    const bool remaining = (lab[i] == 0) & (pts[i][2] > 0) & (pts[i][2] < std::numeric_limits<float>::infinity());
+    state[static_cast<size_t>(i)] = remaining ? kRemaining : 0;
+    num_remaining += remaining;
   }
 
   // Region growing of the remaining pixels; segment_of = index + 1, 0 = not remaining. The pixels of
-  // all segments are stored one after another: segment s is pixels[begin[s], begin[s + 1]).
+  // all segments are stored one after another (Segment::begin, end).
   std::vector<int> segment_of(static_cast<size_t>(total), 0);
   std::vector<Segment> segments;
   const float grow2 = static_cast<float>(params.grow_distance * params.grow_distance);
   std::vector<int> pixels;
-  for (int seed_px = 0; seed_px < total; ++seed_px) {
-    if (state[static_cast<size_t>(seed_px)] != kRemaining) continue;
+  pixels.reserve(num_remaining);
+  for (int seed_px = next_remaining(state, 0); seed_px < total; seed_px = next_remaining(state, seed_px + 1)) {
     const int id = static_cast<int>(segments.size()) + 1;
     const size_t begin = pixels.size();
     pixels.push_back(seed_px);
@@ -145,6 +161,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
 
   std::vector<int> ring_stamp(static_cast<size_t>(total), 0);  // last segment that counted this pixel
   int next_object = num_objects;
+  std::vector<std::pair<int, int>> faces;     // per segment: (patch label, ring pixels)
+  std::vector<std::pair<Plane, int>> planes;  // per segment in rule 5: plane, object id
   for (size_t s = 0; s < segments.size(); ++s) {
     const Segment& seg = segments[s];
     const std::span<const int> seg_pixels(pixels.data() + seg.begin, seg.end - seg.begin);
@@ -152,7 +170,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     // The ring: pixels 8-adjacent to the segment, each counted once.
     bool touches_border = false;
     int other_segment = 0, invalid = 0;
-    std::vector<std::pair<int, int>> faces;  // (patch label, ring pixels)
+    faces.clear();
     for (int i : seg_pixels) {
       const int x = i % width, y = i / width;
       for (int k = 0; k < 8; ++k) {
@@ -192,7 +210,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       continue;
     }
     // Rule 5: per pixel, the neighbouring face whose local plane fits best.
-    std::vector<std::pair<Plane, int>> planes;  // plane, object id
+    planes.clear();
     for (const auto& f : faces) {
       Plane plane;
       if (fit_plane_near(assigned_labels, points, f.first, seg.bbox, plane)) planes.emplace_back(plane, object_of(f.first));
