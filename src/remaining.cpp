@@ -36,8 +36,9 @@ struct Segment {
   cv::Rect bbox;
 };
 
-// States of a pixel during the growing.
-constexpr uchar kRemaining = 1, kGrown = 2;
+// States of a pixel: still to grow, grown into a segment, in the segment being looked at; plus a bit
+// for the ring pixels of that segment.
+constexpr uchar kRemaining = 1, kGrown = 2, kInSegment = 3, kInRing = 0x80;
 
 // The first pixel at or after `from` still to grow (state.size() if none). memchr: the remaining pixels
 // are few and scattered, and it scans many bytes per step.
@@ -111,34 +112,31 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   // Object id of every patch label (index 0: no patch).
   std::vector<int> object_of_label(static_cast<size_t>(num_patches) + 1, 0);
   for (int p = 0; p < num_patches; ++p) object_of_label[static_cast<size_t>(p) + 1] = object_of_patch[static_cast<size_t>(p)] + 1;
-  double max_label = 0;
-  cv::minMaxLoc(assigned_labels, nullptr, &max_label);
-  if (max_label > num_patches) throw Error("assign_remaining: patch label out of range");
   cv::Mat objects(assigned_labels.size(), CV_32S);
   int* obj = objects.ptr<int>();
   // Remaining pixels (no patch, valid) are marked once, so the growing below reads one byte per pixel.
   std::vector<uchar> state(static_cast<size_t>(total), 0);
   size_t num_remaining = 0;
+  int max_label = 0;
   for (int i = 0; i < total; ++i) {  // branch-free (& not &&): labels and depth are noisy at edges
-    obj[i] = object_of_label[static_cast<size_t>(std::max(lab[i], 0))];
+    max_label = std::max(max_label, lab[i]);
+    obj[i] = object_of_label[static_cast<size_t>(std::clamp(lab[i], 0, num_patches))];  // checked below
     const bool remaining = (lab[i] == 0) & (pts[i][2] > 0) & (pts[i][2] < std::numeric_limits<float>::infinity());
     state[static_cast<size_t>(i)] = remaining ? kRemaining : 0;
     num_remaining += remaining;
   }
+  if (max_label > num_patches) throw Error("assign_remaining: patch label out of range");
 
-  // Region growing of the remaining pixels; segment_of = index + 1, 0 = not remaining. The pixels of
-  // all segments are stored one after another (Segment::begin, end).
-  std::vector<int> segment_of(static_cast<size_t>(total), 0);
+  // Region growing of the remaining pixels. The pixels of all segments are stored one after another
+  // (Segment::begin, end).
   std::vector<Segment> segments;
   const float grow2 = static_cast<float>(params.grow_distance * params.grow_distance);
   std::vector<int> pixels;
   pixels.reserve(num_remaining);
   for (int seed_px = next_remaining(state, 0); seed_px < total; seed_px = next_remaining(state, seed_px + 1)) {
-    const int id = static_cast<int>(segments.size()) + 1;
     const size_t begin = pixels.size();
     pixels.push_back(seed_px);
     state[static_cast<size_t>(seed_px)] = kGrown;
-    segment_of[static_cast<size_t>(seed_px)] = id;
     int x0 = width, y0 = height, x1 = -1, y1 = -1;
     for (size_t head = begin; head < pixels.size(); ++head) {  // every pixel enters once: bounded
       const int i = pixels[head];
@@ -152,43 +150,47 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         const cv::Vec3f d = pts[i] - pts[j];
         if (d.dot(d) >= grow2) continue;
         state[static_cast<size_t>(j)] = kGrown;
-        segment_of[static_cast<size_t>(j)] = id;
         pixels.push_back(j);
       }
     }
     segments.push_back({begin, pixels.size(), cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1)});
   }
 
-  std::vector<int> ring_stamp(static_cast<size_t>(total), 0);  // last segment that counted this pixel
   int next_object = num_objects;
+  std::vector<int> ring;                      // per segment: its ring pixels
   std::vector<std::pair<int, int>> faces;     // per segment: (patch label, ring pixels)
   std::vector<std::pair<Plane, int>> planes;  // per segment in rule 5: plane, object id
   for (size_t s = 0; s < segments.size(); ++s) {
     const Segment& seg = segments[s];
     const std::span<const int> seg_pixels(pixels.data() + seg.begin, seg.end - seg.begin);
-    const int id = static_cast<int>(s) + 1;
-    // The ring: pixels 8-adjacent to the segment, each counted once.
+    // The ring: pixels 8-adjacent to the segment, each counted once (marked in `state` while the
+    // segment is looked at, then unmarked: the work stays proportional to the segment).
     bool touches_border = false;
     int other_segment = 0, invalid = 0;
     faces.clear();
+    ring.clear();
+    for (int i : seg_pixels) state[static_cast<size_t>(i)] = kInSegment;
     for (int i : seg_pixels) {
       const int x = i % width, y = i / width;
       for (int k = 0; k < 8; ++k) {
         const int xx = x + kDx[k], yy = y + kDy[k];
         if (xx < 0 || yy < 0 || xx >= width || yy >= height) { touches_border = true; continue; }
         const int j = yy * width + xx;
-        if (segment_of[static_cast<size_t>(j)] == id || ring_stamp[static_cast<size_t>(j)] == id) continue;
-        ring_stamp[static_cast<size_t>(j)] = id;
+        if (state[static_cast<size_t>(j)] == kInSegment || (state[static_cast<size_t>(j)] & kInRing)) continue;
+        state[static_cast<size_t>(j)] |= kInRing;
+        ring.push_back(j);
         if (lab[j] > 0) {
           auto it = std::find_if(faces.begin(), faces.end(), [&](const auto& f) { return f.first == lab[j]; });
           if (it == faces.end()) faces.emplace_back(lab[j], 1); else ++it->second;
-        } else if (segment_of[static_cast<size_t>(j)]) {
+        } else if (state[static_cast<size_t>(j)] == (kGrown | kInRing)) {
           ++other_segment;
         } else {
           ++invalid;
         }
       }
     }
+    for (int i : seg_pixels) state[static_cast<size_t>(i)] = kGrown;
+    for (int j : ring) state[static_cast<size_t>(j)] &= static_cast<uchar>(~kInRing);
     std::sort(faces.begin(), faces.end());  // by label: independent of the scan order
     auto set_all = [&](int object_id) { for (int i : seg_pixels) obj[i] = object_id; };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
