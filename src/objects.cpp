@@ -230,17 +230,13 @@ struct Heights {
   int samples = 0, in_band = 0, above_max = 0, below = 0, over_region = 0;
 };
 
-// A run of equal object labels in scan order: pixels [begin, end) of object `object` (0-based).
-struct Run {
-  int object, begin, end;
-};
-
-// Every run of the labels 1..num_objects. Labels come in long runs (an object's row segments), so
+// Calls visit(object, begin, end) for every run of equal labels 1..num_objects in scan order: pixels
+// [begin, end) of object `object` (0-based). Labels come in long runs (an object's row segments), so
 // per-object sums can live in registers for a run.
-std::vector<Run> label_runs(const cv::Mat& object_labels, int num_objects) {
+template <class Visit>
+void for_each_run(const cv::Mat& object_labels, int num_objects, Visit visit) {
   const int* lab = object_labels.ptr<int>();
   const int total = static_cast<int>(object_labels.total());
-  std::vector<Run> runs;
   for (int begin = 0; begin < total;) {
     const int id = lab[begin];
     int end = begin + 1;
@@ -248,10 +244,9 @@ std::vector<Run> label_runs(const cv::Mat& object_labels, int num_objects) {
     while (end + 4 <= total && ((lab[end] ^ id) | (lab[end + 1] ^ id) | (lab[end + 2] ^ id) | (lab[end + 3] ^ id)) == 0)
       end += 4;
     while (end < total && lab[end] == id) ++end;
-    if (id > 0 && id <= num_objects) runs.push_back({id - 1, begin, end});
+    if (id > 0 && id <= num_objects) visit(id - 1, begin, end);
     begin = end;
   }
-  return runs;
 }
 
 // First and second moments of an object's points in the camera frame. Summed in scan order, one
@@ -272,16 +267,16 @@ struct Moments {
 void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo, const cv::Mat& object_labels,
                      const cv::Mat& points, const Camera& camera) {
   const auto* pts = points.ptr<cv::Vec3f>();
-  std::vector<Run> runs = label_runs(object_labels, static_cast<int>(objects.size()));
-  std::erase_if(runs, [&](const Run& run) { return !redo[static_cast<size_t>(run.object)]; });
+  const int num_objects = static_cast<int>(objects.size());
   std::vector<Moments> moments(objects.size());
-  for (const Run& run : runs) {
-    objects[static_cast<size_t>(run.object)].pixel_count += run.end - run.begin;
-    Moments m = moments[static_cast<size_t>(run.object)];
-    for (int i = run.begin; i < run.end; ++i)
+  for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
+    if (!redo[static_cast<size_t>(o)]) return;
+    objects[static_cast<size_t>(o)].pixel_count += end - begin;
+    Moments m = moments[static_cast<size_t>(o)];
+    for (int i = begin; i < end; ++i)
       if (pts[i][2] > 0) m.add(pts[i]);
-    moments[static_cast<size_t>(run.object)] = m;
-  }
+    moments[static_cast<size_t>(o)] = m;
+  });
   // Axes in the camera frame (rows of axes_t); float extents are plenty for millimetres at a few metres.
   const Eigen::Matrix3d rot = camera.camera_to_robot.topLeftCorner<3, 3>();
   const Eigen::Vector3d shift = camera.camera_to_robot.topRightCorner<3, 1>();
@@ -301,18 +296,19 @@ void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo
   constexpr float kInf = std::numeric_limits<float>::infinity();
   std::vector<Eigen::Vector3f> low(objects.size(), Eigen::Vector3f::Constant(kInf));
   std::vector<Eigen::Vector3f> high(objects.size(), Eigen::Vector3f::Constant(-kInf));
-  for (const Run& run : runs) {
-    const Eigen::Matrix3f a = axes_t[static_cast<size_t>(run.object)];
-    Eigen::Vector3f lo = low[static_cast<size_t>(run.object)], hi = high[static_cast<size_t>(run.object)];
-    for (int i = run.begin; i < run.end; ++i) {
+  for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
+    if (!redo[static_cast<size_t>(o)]) return;
+    const Eigen::Matrix3f a = axes_t[static_cast<size_t>(o)];
+    Eigen::Vector3f lo = low[static_cast<size_t>(o)], hi = high[static_cast<size_t>(o)];
+    for (int i = begin; i < end; ++i) {
       if (!(pts[i][2] > 0)) continue;
       const Eigen::Vector3f c = a * Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
       lo = lo.cwiseMin(c);
       hi = hi.cwiseMax(c);
     }
-    low[static_cast<size_t>(run.object)] = lo;
-    high[static_cast<size_t>(run.object)] = hi;
-  }
+    low[static_cast<size_t>(o)] = lo;
+    high[static_cast<size_t>(o)] = hi;
+  });
   for (size_t o = 0; o < objects.size(); ++o) {
     if (!redo[o] || moments[o].valid == 0) continue;
     // Axes ordered by extent, largest first, and right-handed.
@@ -337,9 +333,10 @@ std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat
                                      const std::vector<float>& cut_cost, const Camera& camera) {
   if (object_labels.type() != CV_32S || points.type() != CV_32FC3 || object_labels.size() != points.size())
     throw Error("describe_objects: labels must be CV_32S and points CV_32FC3 of the same size");
-  double max_id = 0;
-  cv::minMaxLoc(object_labels, nullptr, &max_id);
-  const int count = static_cast<int>(max_id);
+  int count = 0;  // the largest label (a plain loop: cv::minMaxLoc is several times slower)
+  const int* lab = object_labels.ptr<int>();
+  const size_t total = object_labels.total();
+  for (size_t i = 0; i < total; ++i) count = std::max(count, lab[i]);
   std::vector<Object> objects(static_cast<size_t>(std::max(0, count)));
   describe_shapes(objects, std::vector<char>(objects.size(), 1), object_labels, points, camera);
   for (size_t o = 0; o < objects.size(); ++o) {
@@ -368,16 +365,16 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
   int valid_total = 0;  // labelled pixels (valid or not)
   {
     std::vector<int> countdown(objects.size(), 0);
-    for (const Run& run : label_runs(object_labels, num_objects)) {
-      valid_total += run.end - run.begin;
-      const int stride = std::max(1, objects[static_cast<size_t>(run.object)].pixel_count / kSamplesPerObject);
-      int& wait = countdown[static_cast<size_t>(run.object)];
-      for (int i = run.begin; i < run.end; ++i) {
+    for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
+      valid_total += end - begin;
+      const int stride = std::max(1, objects[static_cast<size_t>(o)].pixel_count / kSamplesPerObject);
+      int& wait = countdown[static_cast<size_t>(o)];
+      for (int i = begin; i < end; ++i) {
         if (!valid_point(pts[i]) || wait-- > 0) continue;
         wait = stride - 1;
-        samples[static_cast<size_t>(run.object)].push_back(i);
+        samples[static_cast<size_t>(o)].push_back(i);
       }
-    }
+    });
   }
 
   // Candidates: the 4 largest flat patches with >= 2 % of the labelled pixels. Patches are judged
@@ -503,14 +500,14 @@ int split_support(cv::Mat& object_labels, std::vector<Object>& objects, const Pl
   constexpr uchar kClear = 255, kQueued = 1;
   cv::Mat clear(object_labels.size(), CV_8U, cv::Scalar(0));
   uchar* mask = clear.ptr<uchar>();
-  for (const Run& run : label_runs(object_labels, num_objects)) {
-    if (!objects[static_cast<size_t>(run.object)].support) continue;
-    for (int i = run.begin; i < run.end; ++i) {
+  for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
+    if (!objects[static_cast<size_t>(o)].support) return;
+    for (int i = begin; i < end; ++i) {
       if (!valid_point(pts[i])) continue;
       const float h = table.distance(Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]));
       mask[i] = h > params.plane_band && h <= params.max_height ? kClear : 0;
     }
-  }
+  });
   // Groups: 8-connected, and neighbours closer than plane_band in 3D (a box in front of a keyboard is
   // not one object with it). Each pixel enters the queue once: bounded.
   std::vector<int> queue;
