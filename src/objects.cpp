@@ -192,6 +192,9 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
   for (size_t k = 0; k < pixels.size(); k += stride)
     if (valid_point(pts[pixels[k]])) sample.push_back(pixels[k]);
   if (sample.size() < 10) return 0;
+  std::vector<Eigen::Vector3f> sample_points;  // contiguous: each of the 30 draws counts over all of them
+  sample_points.reserve(sample.size());
+  for (int i : sample) sample_points.emplace_back(pts[i][0], pts[i][1], pts[i][2]);
   std::uint64_t state = 0x9e3779b97f4a7c15ULL ^ pixels.size();
   auto next = [&] {  // xorshift64: a small, portable, seeded generator
     state ^= state << 13; state ^= state >> 7; state ^= state << 17;
@@ -209,7 +212,7 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
     if (n.dot(a) > 0) n = -n;
     Plane candidate{n, -n.dot(a)};
     int count = 0;
-    for (int i : sample) count += std::abs(candidate.distance(to_eigen(pts[i]).cast<float>())) <= band;
+    for (const Eigen::Vector3f& q : sample_points) count += std::abs(candidate.distance(q)) <= band;
     if (count > best_count) { best_count = count; best = candidate; }
   }
   if (best_count <= 0) return 0;
@@ -217,8 +220,10 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
   for (int i : sample)
     if (std::abs(best.distance(to_eigen(pts[i]).cast<float>())) <= band) inliers.push_back(i);
   plane = best;
-  if (fit_plane(inliers, points, plane) && inlier_share(sample, points, plane, band) >= static_cast<double>(best_count) / sample.size())
-    return inlier_share(sample, points, plane, band);
+  if (fit_plane(inliers, points, plane)) {
+    const double share = inlier_share(sample, points, plane, band);
+    if (share >= static_cast<double>(best_count) / sample.size()) return share;
+  }
   plane = best;
   return static_cast<double>(best_count) / sample.size();
 }
