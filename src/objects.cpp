@@ -182,6 +182,25 @@ double inlier_share(const std::vector<int>& pixels, const cv::Mat& points, const
   return n ? static_cast<double>(in) / n : 0.0;
 }
 
+// inlier_share(...) >= share, the same points visited, but it stops once the points left could not
+// lift the share to `share` even if all were inliers (most patches are far from the table's plane).
+bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double band, double share) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
+  const size_t visits = (pixels.size() + stride - 1) / stride;
+  int in = 0, n = 0;
+  for (size_t v = 0; v < visits; ++v) {
+    const int i = pixels[v * stride];
+    if (!valid_point(pts[i])) continue;
+    ++n;
+    in += std::abs(plane.distance(to_eigen(pts[i]).cast<float>())) <= band;
+    // Best final share (in + left) / (n + left); half a point of margin keeps rounding out of it.
+    const double left = static_cast<double>(visits - v - 1);
+    if (in + left < share * (n + left) - 0.5) return false;
+  }
+  return n && static_cast<double>(in) / n >= share;
+}
+
 // Dominant plane of a patch: RANSAC over its points (a table patch may hold the foot of an object that
 // the edges did not separate), refined by least squares on the inliers. Deterministic: the draws are
 // seeded by the patch size. Returns the inlier share.
@@ -464,7 +483,7 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
   {
     std::vector<int> table_pixels;
     for (const auto& patch : patches)
-      if (inlier_share(patch.pixels, points, best_region.plane, params.plane_band) >= 0.8)
+      if (mostly_within(patch.pixels, points, best_region.plane, params.plane_band, 0.8))
         table_pixels.insert(table_pixels.end(), patch.pixels.begin(), patch.pixels.end());
     best_region = region_of(best_region.plane, table_pixels, points, params.region_margin);
   }
@@ -486,7 +505,7 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
       if (largest < 0 || patches[static_cast<size_t>(p)].pixels.size() > patches[static_cast<size_t>(largest)].pixels.size()) largest = p;
     Plane own;
     if (largest >= 0 && fit_plane(patches[static_cast<size_t>(largest)].pixels, points, own) &&
-        inlier_share(patches[static_cast<size_t>(largest)].pixels, points, own, params.plane_band) >= 0.9 &&
+        mostly_within(patches[static_cast<size_t>(largest)].pixels, points, own, params.plane_band, 0.9) &&
         std::abs(own.normal.dot(up)) < std::cos(60.0 * M_PI / 180.0) &&
         object.box.extents(0) >= params.wall_min_extent)
       object.background = true;
@@ -573,7 +592,7 @@ int split_support(cv::Mat& object_labels, std::vector<Object>& objects, const Pl
     Object& object = objects[static_cast<size_t>(num_objects) + k];
     Plane own;
     object.background = object.box.extents(0) >= params.wall_min_extent && fit_plane(new_pixels[k], points, own) &&
-                        inlier_share(new_pixels[k], points, own, params.plane_band) >= 0.9 &&
+                        mostly_within(new_pixels[k], points, own, params.plane_band, 0.9) &&
                         std::abs(own.normal.dot(table.normal)) < std::cos(60.0 * M_PI / 180.0);
   }
   return added;
