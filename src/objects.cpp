@@ -605,9 +605,12 @@ cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& ob
   for (const auto& o : objects)
     if (!o.support && !o.background && o.id > 0 && o.id < static_cast<int>(new_id.size())) new_id[static_cast<size_t>(o.id)] = ++next;
   cv::Mat out(object_labels.size(), CV_32S);
-  object_labels.forEach<int>([&](const int& id, const int* pos) {
-    out.at<int>(pos[0], pos[1]) = id > 0 && id < static_cast<int>(new_id.size()) ? new_id[static_cast<size_t>(id)] : 0;
-  });
+  const int last = static_cast<int>(new_id.size()) - 1;
+  for (int y = 0; y < object_labels.rows; ++y) {
+    const int* lab = object_labels.ptr<int>(y);
+    int* view = out.ptr<int>(y);
+    for (int x = 0; x < object_labels.cols; ++x) view[x] = lab[x] > 0 && lab[x] <= last ? new_id[static_cast<size_t>(lab[x])] : 0;
+  }
   return out;
 }
 
