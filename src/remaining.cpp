@@ -21,6 +21,9 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <span>
 
 namespace clutterseg {
 
@@ -29,9 +32,20 @@ namespace {
 bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
 
 struct Segment {
-  std::vector<int> pixels;
+  size_t begin, end;  // its pixels in the list of all segments' pixels
   cv::Rect bbox;
 };
+
+// States of a pixel: still to grow, grown into a segment, in the segment being looked at; plus a bit
+// for the ring pixels of that segment.
+constexpr uchar kRemaining = 1, kGrown = 2, kInSegment = 3, kInRing = 0x80;
+
+// The first pixel at or after `from` still to grow (state.size() if none). memchr: the remaining pixels
+// are few and scattered, and it scans many bytes per step.
+int next_remaining(const std::vector<uchar>& state, int from) {
+  const auto* found = static_cast<const uchar*>(std::memchr(state.data() + from, kRemaining, state.size() - static_cast<size_t>(from)));
+  return static_cast<int>(found ? found - state.data() : static_cast<std::ptrdiff_t>(state.size()));
+}
 
 constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
 constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
@@ -95,83 +109,99 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   for (int o : object_of_patch)
     if (o < 0 || o >= num_objects) throw Error("assign_remaining: object index out of range");
 
-  cv::Mat objects(assigned_labels.size(), CV_32S, cv::Scalar(0));
+  // Object id of every patch label (index 0: no patch).
+  std::vector<int> object_of_label(static_cast<size_t>(num_patches) + 1, 0);
+  for (int p = 0; p < num_patches; ++p) object_of_label[static_cast<size_t>(p) + 1] = object_of_patch[static_cast<size_t>(p)] + 1;
+  cv::Mat objects(assigned_labels.size(), CV_32S);
   int* obj = objects.ptr<int>();
-  for (int i = 0; i < total; ++i) {
-    if (lab[i] > num_patches) throw Error("assign_remaining: patch label out of range");
-    if (lab[i] > 0) obj[i] = object_of_patch[static_cast<size_t>(lab[i] - 1)] + 1;
+  // Remaining pixels (no patch, valid) are marked once, so the growing below reads one byte per pixel.
+  std::vector<uchar> state(static_cast<size_t>(total), 0);
+  size_t num_remaining = 0;
+  int max_label = 0;
+  for (int i = 0; i < total; ++i) {  // branch-free (& not &&): labels and depth are noisy at edges
+    max_label = std::max(max_label, lab[i]);
+    obj[i] = object_of_label[static_cast<size_t>(std::clamp(lab[i], 0, num_patches))];  // checked below
+    const bool remaining = (lab[i] == 0) & (pts[i][2] > 0) & (pts[i][2] < std::numeric_limits<float>::infinity());
+    state[static_cast<size_t>(i)] = remaining ? kRemaining : 0;
+    num_remaining += remaining;
   }
+  if (max_label > num_patches) throw Error("assign_remaining: patch label out of range");
 
-  // Region growing of the unassigned valid pixels; segment_of = index + 1, 0 = not remaining.
-  std::vector<int> segment_of(static_cast<size_t>(total), 0);
+  // Region growing of the remaining pixels. The pixels of all segments are stored one after another
+  // (Segment::begin, end).
   std::vector<Segment> segments;
   const float grow2 = static_cast<float>(params.grow_distance * params.grow_distance);
-  std::vector<int> queue;
-  for (int seed_px = 0; seed_px < total; ++seed_px) {
-    if (lab[seed_px] != 0 || segment_of[static_cast<size_t>(seed_px)] || !valid_point(pts[seed_px])) continue;
-    Segment s;
-    const int id = static_cast<int>(segments.size()) + 1;
-    queue.assign(1, seed_px);
-    segment_of[static_cast<size_t>(seed_px)] = id;
+  std::vector<int> pixels;
+  pixels.reserve(num_remaining);
+  for (int seed_px = next_remaining(state, 0); seed_px < total; seed_px = next_remaining(state, seed_px + 1)) {
+    const size_t begin = pixels.size();
+    pixels.push_back(seed_px);
+    state[static_cast<size_t>(seed_px)] = kGrown;
     int x0 = width, y0 = height, x1 = -1, y1 = -1;
-    for (size_t head = 0; head < queue.size(); ++head) {  // every pixel enters once: bounded
-      const int i = queue[head];
+    for (size_t head = begin; head < pixels.size(); ++head) {  // every pixel enters once: bounded
+      const int i = pixels[head];
       const int x = i % width, y = i / width;
       x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
       for (int k = 0; k < 8; ++k) {
         const int xx = x + kDx[k], yy = y + kDy[k];
         if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
         const int j = yy * width + xx;
-        if (lab[j] != 0 || segment_of[static_cast<size_t>(j)] || !valid_point(pts[j])) continue;
+        if (state[static_cast<size_t>(j)] != kRemaining) continue;
         const cv::Vec3f d = pts[i] - pts[j];
         if (d.dot(d) >= grow2) continue;
-        segment_of[static_cast<size_t>(j)] = id;
-        queue.push_back(j);
+        state[static_cast<size_t>(j)] = kGrown;
+        pixels.push_back(j);
       }
     }
-    s.pixels = queue;
-    s.bbox = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
-    segments.push_back(std::move(s));
+    segments.push_back({begin, pixels.size(), cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1)});
   }
 
-  std::vector<int> ring_stamp(static_cast<size_t>(total), 0);  // last segment that counted this pixel
   int next_object = num_objects;
+  std::vector<int> ring;                      // per segment: its ring pixels
+  std::vector<std::pair<int, int>> faces;     // per segment: (patch label, ring pixels)
+  std::vector<std::pair<Plane, int>> planes;  // per segment in rule 5: plane, object id
   for (size_t s = 0; s < segments.size(); ++s) {
     const Segment& seg = segments[s];
-    const int id = static_cast<int>(s) + 1;
-    // The ring: pixels 8-adjacent to the segment, each counted once.
+    const std::span<const int> seg_pixels(pixels.data() + seg.begin, seg.end - seg.begin);
+    // The ring: pixels 8-adjacent to the segment, each counted once (marked in `state` while the
+    // segment is looked at, then unmarked: the work stays proportional to the segment).
     bool touches_border = false;
     int other_segment = 0, invalid = 0;
-    std::vector<std::pair<int, int>> faces;  // (patch label, ring pixels)
-    for (int i : seg.pixels) {
+    faces.clear();
+    ring.clear();
+    for (int i : seg_pixels) state[static_cast<size_t>(i)] = kInSegment;
+    for (int i : seg_pixels) {
       const int x = i % width, y = i / width;
       for (int k = 0; k < 8; ++k) {
         const int xx = x + kDx[k], yy = y + kDy[k];
         if (xx < 0 || yy < 0 || xx >= width || yy >= height) { touches_border = true; continue; }
         const int j = yy * width + xx;
-        if (segment_of[static_cast<size_t>(j)] == id || ring_stamp[static_cast<size_t>(j)] == id) continue;
-        ring_stamp[static_cast<size_t>(j)] = id;
+        if (state[static_cast<size_t>(j)] == kInSegment || (state[static_cast<size_t>(j)] & kInRing)) continue;
+        state[static_cast<size_t>(j)] |= kInRing;
+        ring.push_back(j);
         if (lab[j] > 0) {
           auto it = std::find_if(faces.begin(), faces.end(), [&](const auto& f) { return f.first == lab[j]; });
           if (it == faces.end()) faces.emplace_back(lab[j], 1); else ++it->second;
-        } else if (segment_of[static_cast<size_t>(j)]) {
+        } else if (state[static_cast<size_t>(j)] == (kGrown | kInRing)) {
           ++other_segment;
         } else {
           ++invalid;
         }
       }
     }
+    for (int i : seg_pixels) state[static_cast<size_t>(i)] = kGrown;
+    for (int j : ring) state[static_cast<size_t>(j)] &= static_cast<uchar>(~kInRing);
     std::sort(faces.begin(), faces.end());  // by label: independent of the scan order
-    auto set_all = [&](int object_id) { for (int i : seg.pixels) obj[i] = object_id; };
+    auto set_all = [&](int object_id) { for (int i : seg_pixels) obj[i] = object_id; };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
 
     if (faces.empty()) {                                              // rule 1
       // A tiny segment alone is sensor noise (stereo sensors leave thousands of them), not an object.
-      if (static_cast<int>(seg.pixels.size()) >= tiny_px) set_all(++next_object);
+      if (static_cast<int>(seg_pixels.size()) >= tiny_px) set_all(++next_object);
       continue;
     }
     if (faces.size() == 1) {
-      const bool tiny = static_cast<int>(seg.pixels.size()) < tiny_px;          // rule 2
+      const bool tiny = static_cast<int>(seg_pixels.size()) < tiny_px;          // rule 2
       const bool enclosed = !touches_border && other_segment == 0 && faces[0].second >= invalid;  // rule 3
       set_all(!tiny && enclosed ? ++next_object : object_of(faces[0].first));
       continue;
@@ -182,7 +212,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       continue;
     }
     // Rule 5: per pixel, the neighbouring face whose local plane fits best.
-    std::vector<std::pair<Plane, int>> planes;  // plane, object id
+    planes.clear();
     for (const auto& f : faces) {
       Plane plane;
       if (fit_plane_near(assigned_labels, points, f.first, seg.bbox, plane)) planes.emplace_back(plane, object_of(f.first));
@@ -192,7 +222,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       set_all(object_of(best->first));
       continue;
     }
-    for (int i : seg.pixels) {
+    for (int i : seg_pixels) {
       const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
       float best = std::numeric_limits<float>::infinity();
       for (const auto& [plane, object_id] : planes) {
