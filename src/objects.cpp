@@ -11,6 +11,8 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
+#include "clutterseg/parallel.hpp"
+
 namespace clutterseg {
 
 namespace {
@@ -273,17 +275,62 @@ void for_each_run(const cv::Mat& object_labels, int num_objects, Visit visit) {
   }
 }
 
-// First and second moments of an object's points in the camera frame. Summed in scan order, one
-// point at a time, so that the result does not depend on how the image is traversed.
-struct Moments {
-  double x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-  int valid = 0;
-  void add(const cv::Vec3f& p) {
-    const double px = p[0], py = p[1], pz = p[2];
-    x += px; y += py; z += pz;
-    xx += px * px; xy += px * py; xz += px * pz; yy += py * py; yz += py * pz; zz += pz * pz;
-    ++valid;
+// Sums over the valid points of a run, relative to `origin`: n, then x, y, z, then xx, xy, xz, yy, yz, zz.
+// Vectorised (float lanes, OpenMP simd); relative to a point of the object the values are centimetres,
+// so float sums of a run (at most one image row) lose nothing that matters.
+CLUTTERSEG_ROW_KERNEL void centred_sums(const float* __restrict xyz, int count, const float* __restrict origin,
+                                        double* __restrict total) {
+  float n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  const float ox = origin[0], oy = origin[1], oz = origin[2];
+#pragma omp simd reduction(+ : n, x, y, z, xx, xy, xz, yy, yz, zz)
+  for (int k = 0; k < count; ++k) {
+    const bool valid = xyz[3 * k + 2] > 0;
+    const float dx = valid ? xyz[3 * k] - ox : 0.f, dy = valid ? xyz[3 * k + 1] - oy : 0.f;
+    const float dz = valid ? xyz[3 * k + 2] - oz : 0.f;
+    n += valid ? 1.f : 0.f;
+    x += dx; y += dy; z += dz;
+    xx += dx * dx; xy += dx * dy; xz += dx * dz; yy += dy * dy; yz += dy * dz; zz += dz * dz;
   }
+  const float run[10] = {n, x, y, z, xx, xy, xz, yy, yz, zz};
+  for (int k = 0; k < 10; ++k) total[k] += run[k];
+}
+
+// Lowest and highest values of axes * p over the valid points of a run (axes: row-major 3x3).
+CLUTTERSEG_ROW_KERNEL void extents_along(const float* __restrict xyz, int count, const float* __restrict axes,
+                                         float* __restrict low, float* __restrict high) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  float lo0 = low[0], lo1 = low[1], lo2 = low[2], hi0 = high[0], hi1 = high[1], hi2 = high[2];
+  const float a00 = axes[0], a01 = axes[1], a02 = axes[2], a10 = axes[3], a11 = axes[4], a12 = axes[5];
+  const float a20 = axes[6], a21 = axes[7], a22 = axes[8];
+#pragma omp simd reduction(min : lo0, lo1, lo2) reduction(max : hi0, hi1, hi2)
+  for (int k = 0; k < count; ++k) {
+    const float px = xyz[3 * k], py = xyz[3 * k + 1], pz = xyz[3 * k + 2];
+    const bool valid = pz > 0;
+    const float c0 = a00 * px + a01 * py + a02 * pz, c1 = a10 * px + a11 * py + a12 * pz;
+    const float c2 = a20 * px + a21 * py + a22 * pz;
+    lo0 = std::min(lo0, valid ? c0 : kInf); hi0 = std::max(hi0, valid ? c0 : -kInf);
+    lo1 = std::min(lo1, valid ? c1 : kInf); hi1 = std::max(hi1, valid ? c1 : -kInf);
+    lo2 = std::min(lo2, valid ? c2 : kInf); hi2 = std::max(hi2, valid ? c2 : -kInf);
+  }
+  low[0] = lo0; low[1] = lo1; low[2] = lo2;
+  high[0] = hi0; high[1] = hi1; high[2] = hi2;
+}
+
+// First and second moments of an object's points, summed relative to its first valid point (centred
+// sums: no cancellation between metre-sized squares in the covariance).
+struct Moments {
+  std::array<float, 3> origin{};
+  bool has_origin = false;
+  std::array<double, 10> sums{};  // n, x, y, z, xx, xy, xz, yy, yz, zz
+  void add_run(const cv::Vec3f* p, int count) {
+    for (int k = 0; !has_origin && k < count; ++k)
+      if (p[k][2] > 0) {
+        origin = {p[k][0], p[k][1], p[k][2]};
+        has_origin = true;
+      }
+    if (has_origin) centred_sums(&p[0][0], count, origin.data(), sums.data());
+  }
+  int valid() const { return static_cast<int>(sums[0]); }
 };
 
 // Pixel count, centroid and PCA box of the objects flagged in `redo` (statistics only: id, patches,
@@ -296,45 +343,37 @@ void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo
   for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
     if (!redo[static_cast<size_t>(o)]) return;
     objects[static_cast<size_t>(o)].pixel_count += end - begin;
-    Moments m = moments[static_cast<size_t>(o)];
-    for (int i = begin; i < end; ++i)
-      if (pts[i][2] > 0) m.add(pts[i]);
-    moments[static_cast<size_t>(o)] = m;
+    moments[static_cast<size_t>(o)].add_run(pts + begin, end - begin);
   });
   // Axes in the camera frame (rows of axes_t); float extents are plenty for millimetres at a few metres.
   const Eigen::Matrix3d rot = camera.camera_to_robot.topLeftCorner<3, 3>();
   const Eigen::Vector3d shift = camera.camera_to_robot.topRightCorner<3, 1>();
   std::vector<Eigen::Matrix3d> axes(objects.size(), Eigen::Matrix3d::Identity());
-  std::vector<Eigen::Matrix3f> axes_t(objects.size(), Eigen::Matrix3f::Identity());
+  std::vector<std::array<float, 9>> axes_t(objects.size(), {1, 0, 0, 0, 1, 0, 0, 0, 1});  // row-major
   for (size_t o = 0; o < objects.size(); ++o) {
     const Moments& m = moments[o];
-    if (!redo[o] || m.valid == 0) continue;
-    const Eigen::Vector3d mean = Eigen::Vector3d(m.x, m.y, m.z) / m.valid;
+    if (!redo[o] || m.valid() == 0) continue;
+    const auto& s = m.sums;
+    const Eigen::Vector3d offset = Eigen::Vector3d(s[1], s[2], s[3]) / s[0];  // mean - origin
     Eigen::Matrix3d second;
-    second << m.xx, m.xy, m.xz, m.xy, m.yy, m.yz, m.xz, m.yz, m.zz;
+    second << s[4], s[5], s[6], s[5], s[7], s[8], s[6], s[8], s[9];
+    const Eigen::Vector3d mean = Eigen::Vector3f(m.origin[0], m.origin[1], m.origin[2]).cast<double>() + offset;
     objects[o].centroid = (rot * mean + shift).cast<float>();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(second / m.valid - mean * mean.transpose());
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(second / s[0] - offset * offset.transpose());
     axes[o] = eig.eigenvectors();
-    axes_t[o] = axes[o].transpose().cast<float>();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) axes_t[o][static_cast<size_t>(3 * r + c)] = static_cast<float>(axes[o](c, r));
   }
   constexpr float kInf = std::numeric_limits<float>::infinity();
   std::vector<Eigen::Vector3f> low(objects.size(), Eigen::Vector3f::Constant(kInf));
   std::vector<Eigen::Vector3f> high(objects.size(), Eigen::Vector3f::Constant(-kInf));
   for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
     if (!redo[static_cast<size_t>(o)]) return;
-    const Eigen::Matrix3f a = axes_t[static_cast<size_t>(o)];
-    Eigen::Vector3f lo = low[static_cast<size_t>(o)], hi = high[static_cast<size_t>(o)];
-    for (int i = begin; i < end; ++i) {
-      if (!(pts[i][2] > 0)) continue;
-      const Eigen::Vector3f c = a * Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
-      lo = lo.cwiseMin(c);
-      hi = hi.cwiseMax(c);
-    }
-    low[static_cast<size_t>(o)] = lo;
-    high[static_cast<size_t>(o)] = hi;
+    extents_along(&pts[begin][0], end - begin, axes_t[static_cast<size_t>(o)].data(), low[static_cast<size_t>(o)].data(),
+                  high[static_cast<size_t>(o)].data());
   });
   for (size_t o = 0; o < objects.size(); ++o) {
-    if (!redo[o] || moments[o].valid == 0) continue;
+    if (!redo[o] || moments[o].valid() == 0) continue;
     // Axes ordered by extent, largest first, and right-handed.
     const Eigen::Vector3d lo = low[o].cast<double>(), hi = high[o].cast<double>();
     const Eigen::Vector3d extent = hi - lo;
@@ -344,6 +383,13 @@ void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo
     for (int k = 0; k < 3; ++k) {
       box.axes.col(k) = (rot * axes[o].col(order[static_cast<size_t>(k)])).cast<float>();
       box.extents(k) = static_cast<float>(extent(order[static_cast<size_t>(k)]));
+    }
+    // Eigenvectors come with an arbitrary sign that rounding can flip: the largest component of the
+    // first two axes is made positive, so that the same object gets the same box.
+    for (int k = 0; k < 2; ++k) {
+      Eigen::Index largest = 0;
+      box.axes.col(k).cwiseAbs().maxCoeff(&largest);
+      if (box.axes(largest, k) < 0) box.axes.col(k) = -box.axes.col(k);
     }
     box.axes.col(2) = box.axes.col(0).cross(box.axes.col(1));
     box.center = (rot * (axes[o] * (0.5 * (lo + hi))) + shift).cast<float>();
