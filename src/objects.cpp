@@ -203,6 +203,20 @@ bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const 
   return n && static_cast<double>(in) / n >= share;
 }
 
+// Points within band of the plane (the same sum as Plane::distance, in a vectorised loop).
+CLUTTERSEG_ROW_KERNEL int count_planar(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                                       int n, float a, float b, float c, float offset, float band) {
+  int count = 0;
+  for (int k = 0; k < n; ++k) count += std::abs(a * x[k] + b * y[k] + c * z[k] + offset) <= band;
+  return count;
+}
+
+int count_within(const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
+                 const Plane& plane, float band) {
+  return count_planar(x.data(), y.data(), z.data(), static_cast<int>(x.size()), plane.normal.x(), plane.normal.y(),
+                      plane.normal.z(), plane.offset, band);
+}
+
 // Dominant plane of a patch: RANSAC over its points (a table patch may hold the foot of an object that
 // the edges did not separate), refined by least squares on the inliers. Deterministic: the draws are
 // seeded by the patch size. Returns the inlier share.
@@ -213,9 +227,12 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
   for (size_t k = 0; k < pixels.size(); k += stride)
     if (valid_point(pts[pixels[k]])) sample.push_back(pixels[k]);
   if (sample.size() < 10) return 0;
-  std::vector<Eigen::Vector3f> sample_points;  // contiguous: each of the 30 draws counts over all of them
-  sample_points.reserve(sample.size());
-  for (int i : sample) sample_points.emplace_back(pts[i][0], pts[i][1], pts[i][2]);
+  std::vector<float> xs, ys, zs;  // contiguous planes: each of the 30 draws counts over all of them
+  for (int i : sample) {
+    xs.push_back(pts[i][0]);
+    ys.push_back(pts[i][1]);
+    zs.push_back(pts[i][2]);
+  }
   std::uint64_t state = 0x9e3779b97f4a7c15ULL ^ pixels.size();
   auto next = [&] {  // xorshift64: a small, portable, seeded generator
     state ^= state << 13; state ^= state >> 7; state ^= state << 17;
@@ -232,8 +249,7 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
     n.normalize();
     if (n.dot(a) > 0) n = -n;
     Plane candidate{n, -n.dot(a)};
-    int count = 0;
-    for (const Eigen::Vector3f& q : sample_points) count += std::abs(candidate.distance(q)) <= band;
+    const int count = count_within(xs, ys, zs, candidate, static_cast<float>(band));
     if (count > best_count) { best_count = count; best = candidate; }
   }
   if (best_count <= 0) return 0;
