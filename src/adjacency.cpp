@@ -2,16 +2,17 @@
 //
 // Speed (see docs/ADJACENCY.md): the naive scan reads every pixel of a disc of radius r around every
 // edge pixel, O(edge pixels x r^2) - 40-90 ms at 640x480 (r = 14). Here the patches are propagated
-// into the edge region instead, one ring of pixels at a time (a bounded multi-source BFS): every
-// non-patch pixel keeps, per patch that reached it, the one seed point (a patch pixel) nearest to it in
-// 3D, chosen among the seeds its 8 neighbours of the previous ring kept (and the patch pixels touching
-// it). Seeds travel at most r pixels (Euclidean, image) from where they started; pixels without depth
-// pass on the seeds nearest in the image. Each edge pixel then does what the paper says with its
-// seeds: all patches with a seed closer than d_max become pairwise adjacent, and the pixel joins the
-// patch of the nearest seed. Cost: O(edge pixels x 8 x seeds kept), seeds kept <= kMaxSeeds.
+// into the edge region instead, in two raster passes as in a chamfer distance transform: every
+// non-patch pixel keeps, per patch that reached it, the one seed (a patch pixel) nearest to it in 3D,
+// chosen among the seeds of its already visited 8-neighbours (and the patch pixels touching it). Seeds
+// travel at most r pixels (Euclidean, image) from where they started; a pixel with depth keeps only
+// seeds closer than d_max (the only ones the rule uses), pixels without depth pass on the seeds
+// nearest in the image. Each edge pixel then does what the paper says with its seeds: all patches with
+// a seed become pairwise adjacent, and the pixel joins the patch of the nearest seed.
+// Cost: O(edge pixels x 8 x seeds kept), seeds kept <= kMaxSeeds.
 // What changes against the naive scan: a patch is seen only through a chain of non-patch pixels (not
-// across another patch), and the nearest point is the nearest among the propagated seeds, not among
-// all patch pixels of the disc. tests/test_adjacency.cpp compares with the naive scan.
+// across another patch) that keep its seed, and the nearest point is the nearest among the propagated
+// seeds, not among all patch pixels of the disc. tests/test_adjacency.cpp compares with the naive scan.
 #include "clutterseg/adjacency.hpp"
 
 #include <algorithm>
@@ -50,9 +51,9 @@ struct SeedSet {
   SeedSet() : count(0) {}  // user-provided: a vector of SeedSets is not zero-filled first
   // Offers a seed: keeps the nearest seed per label and the kMaxSeeds nearest labels. Neighbours mostly
   // pass on a seed this set already holds; that case returns before any distance is computed.
-  // `distance2` gives d2 for the candidate.
+  // `distance2` gives d2 for the candidate; seeds at `limit` or farther are not kept.
   template <typename Distance2>
-  void offer(std::uint32_t yx, int label, Distance2 distance2) {
+  void offer(std::uint32_t yx, int label, Distance2 distance2, float limit) {
     int slot = -1;
     for (int i = 0; i < count; ++i)
       if (seed[i].label == label) {
@@ -61,6 +62,7 @@ struct SeedSet {
         break;
       }
     const Seed s{yx, label, distance2()};
+    if (s.d2 >= limit) return;
     if (slot >= 0) {
       if (nearer(s, seed[slot])) seed[slot] = s;
       return;
@@ -136,7 +138,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
         if (!has_point) return static_cast<float>(dx * dx + dy * dy);
         const cv::Vec3f d = pts[sy * width + sx] - here;
         return d.dot(d);
-      });
+      }, has_point ? d2_max : std::numeric_limits<float>::infinity());
     };
     for (const auto& d : from) {
       const int xx = x + d[0], yy = y + d[1];
