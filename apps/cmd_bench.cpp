@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <ctime>
 #include <time.h>
 #include <fstream>
@@ -29,6 +30,7 @@ struct BenchOptions {
   int frames = 0;   // 0 = all
   int warmup = 1;   // frames run before timing starts
   int repeat = 0;   // passes over the frames; 0 = enough for at least 20 timed frames
+  int subsample = 1;  // keep every N-th row and column (a 640x480 set as a 320x240 sensor with N = 2)
   CameraOptions camera;
   ParamOptions params;
 };
@@ -87,6 +89,26 @@ std::vector<std::string> split_names(const std::string& list) {
   return names;
 }
 
+// Every n-th row and column of the depth, with the intrinsics scaled to match: the same scene as a
+// sensor with n times fewer pixels per axis would see it (nearest neighbour, no new values).
+void subsample_frame(Frame& frame, int n) {
+  if (n <= 1) return;
+  cv::Mat depth(frame.depth.rows / n, frame.depth.cols / n, frame.depth.type());
+  for (int y = 0; y < depth.rows; ++y)
+    for (int x = 0; x < depth.cols; ++x)
+      std::memcpy(depth.ptr(y, x), frame.depth.ptr(y * n, x * n), frame.depth.elemSize());
+  frame.depth = depth;
+  frame.color.release();
+  frame.label.release();
+  Camera& c = frame.camera;
+  c.fx /= n;
+  c.fy /= n;
+  c.cx /= n;
+  c.cy /= n;
+  c.width = depth.cols;
+  c.height = depth.rows;
+}
+
 // Both OpenMP (clutterseg's stages) and OpenCV's own pool (median, Gaussian) follow the thread count.
 void use_threads(int threads) {
   set_threads(threads);
@@ -130,6 +152,7 @@ std::string command_line(const BenchOptions& o) {
   if (o.frames) c += " --frames " + std::to_string(o.frames);
   if (o.warmup != 1) c += " --warmup " + std::to_string(o.warmup);
   if (o.repeat) c += " --repeat " + std::to_string(o.repeat);
+  if (o.subsample > 1) c += " --subsample " + std::to_string(o.subsample);
   if (!o.params.config_file.empty()) c += " --config " + o.params.config_file;
   if (!o.out.empty()) c += " --out " + o.out;
   return c;
@@ -221,6 +244,7 @@ int run(const BenchOptions& o) {
   for (size_t i = 0; i < source.size() && frames.size() < wanted; ++i) {
     try {
       frames.push_back(source.load(i));
+      subsample_frame(frames.back(), o.subsample);
     } catch (const Error& e) {
       report_error(e.what());
     }
@@ -267,6 +291,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--warmup", opts->warmup, "untimed frames per method before timing (default 1)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--repeat", opts->repeat, "timed passes over the frames (default: enough for >= 20 timed frames)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--subsample", opts->subsample, "keep every N-th row and column, intrinsics scaled (2: a 640x480 set as 320x240)")
+      ->check(CLI::Range(1, 16));
   cmd->add_option("--out", opts->out, "also write the markdown tables to this file");
   opts->camera.add_to(*cmd);
   opts->params.add_to(*cmd);  // --threads N: the comparison's thread count (bench default 1)

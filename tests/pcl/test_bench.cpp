@@ -57,3 +57,13 @@ TEST(Bench, UnknownMethodIsAnErrorBeforeAnythingRuns) {
   EXPECT_NE(run("bench " + data.string() + " --with nosuchmethod --out " + (data / "never.md").string() + " > /dev/null 2>&1"), 0);
   EXPECT_FALSE(fs::exists(data / "never.md"));
 }
+
+TEST(Bench, SubsampleTimesTheSameFramesAtHalfTheResolution) {
+  const fs::path data = box_dataset();
+  const fs::path out = data / "half.md";
+  ASSERT_EQ(run("bench " + data.string() + " --subsample 2 --repeat 1 --out " + out.string() + " > /dev/null"), 0);
+  const std::string md = read_text(out);
+  EXPECT_NE(md.find("frames: 2 of 320x240"), std::string::npos) << md;
+  EXPECT_NE(md.find("--subsample 2"), std::string::npos) << md;  // the command that reproduces it
+  EXPECT_NE(run("bench " + data.string() + " --subsample 0 > /dev/null 2>&1"), 0);
+}
