@@ -55,9 +55,11 @@ struct PlaneRegion {
   cv::Mat cells;          // CV_8U, 255 = over the region
   static constexpr float kCell = 0.01f;  // [m]
   bool over(const Eigen::Vector3f& q) const {
-    const int cx = static_cast<int>(std::floor((u.dot(q) - origin.x) / kCell));
-    const int cy = static_cast<int>(std::floor((v.dot(q) - origin.y) / kCell));
-    return cx >= 0 && cy >= 0 && cx < cells.cols && cy < cells.rows && cells.at<uchar>(cy, cx);
+    // Cell coordinates; negative ones are outside, so truncation serves as floor (no division, no floor
+    // call: this runs for every sampled pixel of every object and candidate).
+    const float fx = (u.dot(q) - origin.x) * (1.f / kCell), fy = (v.dot(q) - origin.y) * (1.f / kCell);
+    if (!(fx >= 0 && fy >= 0 && fx < static_cast<float>(cells.cols) && fy < static_cast<float>(cells.rows))) return false;
+    return cells.at<uchar>(static_cast<int>(fy), static_cast<int>(fx)) != 0;
   }
 };
 
