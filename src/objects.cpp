@@ -66,35 +66,54 @@ struct PlaneRegion {
 // cv::convexHull of plane points. It sorts every point (~0.4 ms for the 4000 of a table); points more
 // than 1 mm inside the polygon of the extreme points in 8 directions cannot be hull vertices, so
 // dropping them first gives the same hull.
+// Largest a * x + b * y over the points, a and b in {-1, 0, 1} (exact: no rounding but the one sum).
+CLUTTERSEG_ROW_KERNEL float largest_projection(const float* __restrict x, const float* __restrict y, int n, float a,
+                                               float b) {
+  float largest = -std::numeric_limits<float>::infinity();
+#pragma omp simd reduction(max : largest)
+  for (int i = 0; i < n; ++i) largest = std::max(largest, a * x[i] + b * y[i]);
+  return largest;
+}
+
+// keep[i] &= (a * x + b * y > offset) for one edge of the inner polygon.
+CLUTTERSEG_ROW_KERNEL void keep_inside(const float* __restrict x, const float* __restrict y, int n, float a, float b,
+                                       float offset, uchar* __restrict keep) {
+  for (int i = 0; i < n; ++i) keep[i] &= static_cast<uchar>(a * x[i] + b * y[i] > offset);
+}
+
 std::vector<cv::Point2f> convex_hull(const std::vector<cv::Point2f>& points) {
-  // Extreme points along x, y, x + y and x - y (one pass), in counter-clockwise order of direction.
+  const int n = static_cast<int>(points.size());
+  std::vector<float> xs(points.size()), ys(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    xs[i] = points[i].x;
+    ys[i] = points[i].y;
+  }
+  // Extreme points along x, y, x + y and x - y, in counter-clockwise order of direction: the first
+  // point reaching the largest projection.
+  constexpr float kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1}, kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
   std::array<cv::Point2f, 8> extreme;
-  extreme.fill(points.front());
-  auto along = [](const cv::Point2f& p, int k) {  // projection on direction k * 45 degrees (unnormalised)
-    constexpr float kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1}, kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
-    return kDx[k] * p.x + kDy[k] * p.y;
-  };
-  for (const cv::Point2f& p : points)
-    for (int k = 0; k < 8; ++k)
-      if (along(p, k) > along(extreme[static_cast<size_t>(k)], k)) extreme[static_cast<size_t>(k)] = p;
+  for (int k = 0; k < 8; ++k) {
+    const float largest = largest_projection(xs.data(), ys.data(), n, kDx[k], kDy[k]);
+    int first = 0;
+    while (first + 1 < n && kDx[k] * xs[static_cast<size_t>(first)] + kDy[k] * ys[static_cast<size_t>(first)] < largest) ++first;
+    extreme[static_cast<size_t>(k)] = points[static_cast<size_t>(first)];
+  }
   std::vector<cv::Point2f> polygon;
   for (const cv::Point2f& e : extreme)
     if (polygon.empty() || e != polygon.back()) polygon.push_back(e);
   if (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
-  // Edges as lines n . p = offset with unit normal n pointing inwards (left of the edge).
-  std::vector<cv::Vec3f> edges;
+  // Points more than kMargin inside every edge of that polygon (edges as lines n . p = offset, unit
+  // normal n pointing inwards) cannot be hull vertices.
+  constexpr float kMargin = 0.001f;  // [m], far above the float rounding of plane coordinates
+  std::vector<uchar> inside(points.size(), polygon.size() >= 3 ? 1 : 0);
   for (size_t k = 0; polygon.size() >= 3 && k < polygon.size(); ++k) {
     const cv::Point2f edge = polygon[(k + 1) % polygon.size()] - polygon[k];
-    const cv::Point2f n = cv::Point2f(-edge.y, edge.x) / std::hypot(edge.x, edge.y);
-    edges.emplace_back(n.x, n.y, n.dot(polygon[k]));
+    const cv::Point2f normal = cv::Point2f(-edge.y, edge.x) / std::hypot(edge.x, edge.y);
+    keep_inside(xs.data(), ys.data(), n, normal.x, normal.y, normal.dot(polygon[k]) + kMargin, inside.data());
   }
-  constexpr float kMargin = 0.001f;  // [m], far above the float rounding of plane coordinates
   std::vector<cv::Point2f> outer;
-  for (const cv::Point2f& p : points) {
-    bool inside = !edges.empty();
-    for (const cv::Vec3f& e : edges) inside &= e[0] * p.x + e[1] * p.y > e[2] + kMargin;
-    if (!inside) outer.push_back(p);
-  }
+  for (size_t i = 0; i < points.size(); ++i)
+    if (!inside[i]) outer.push_back(points[i]);
   std::vector<cv::Point2f> hull;
   cv::convexHull(outer, hull);
   return hull;

@@ -30,15 +30,22 @@ namespace {
 float median_of_valid_neighbours(const cv::Mat& depth, int x, int y) {
   float v[9];
   int n = 0;
-  for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, depth.rows - 1); ++yy) {
-    const float* row = depth.ptr<float>(yy);
-    for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, depth.cols - 1); ++xx) {
-      float z = row[xx];
-      if (!(z > 0)) continue;
-      int k = n++;
-      for (; k > 0 && v[k - 1] > z; --k) v[k] = v[k - 1];
-      v[k] = z;
+  auto insert = [&](float z) {
+    if (!(z > 0)) return;
+    int k = n++;
+    for (; k > 0 && v[k - 1] > z; --k) v[k] = v[k - 1];
+    v[k] = z;
+  };
+  if (x > 0 && y > 0 && x + 1 < depth.cols && y + 1 < depth.rows) {  // the common case: no clipping
+    for (int yy = y - 1; yy <= y + 1; ++yy) {
+      const float* row = depth.ptr<float>(yy) + x;
+      insert(row[-1]);
+      insert(row[0]);
+      insert(row[1]);
     }
+  } else {
+    for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, depth.rows - 1); ++yy)
+      for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, depth.cols - 1); ++xx) insert(depth.ptr<float>(yy)[xx]);
   }
   return v[n / 2];  // n >= 1: the pixel itself is valid
 }
