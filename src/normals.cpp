@@ -7,21 +7,29 @@
 
 namespace clutterseg {
 
+namespace {
+
+// One row of back-projected points: (x, y, z) = z * ((u - cx) / fx, (v - cy) / fy, 1), 0 where z = 0.
+CLUTTERSEG_ROW_KERNEL void point_row(const float* __restrict z, const float* __restrict ray_x, float ray_y, int cols,
+                                     float* __restrict p) {
+  for (int x = 0; x < cols; ++x) {
+    p[3 * x] = ray_x[x] * z[x];
+    p[3 * x + 1] = ray_y * z[x];
+    p[3 * x + 2] = z[x];
+  }
+}
+
+}  // namespace
+
 cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera) {
   cv::Mat points(depth.size(), CV_32FC3);
   const float ifx = static_cast<float>(1.0 / camera.fx), ify = static_cast<float>(1.0 / camera.fy);
   const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  std::vector<float> ray_x(static_cast<size_t>(depth.cols));
+  for (int x = 0; x < depth.cols; ++x) ray_x[static_cast<size_t>(x)] = (static_cast<float>(x) - cx) * ifx;
   parallel_for_rows(depth.rows, [&](int begin, int end) {
-    for (int y = begin; y < end; ++y) {
-      const float* z = depth.ptr<float>(y);
-      float* p = points.ptr<float>(y);
-      const float ry = (static_cast<float>(y) - cy) * ify;
-      for (int x = 0; x < depth.cols; ++x) {  // (0,0,0) where z = 0
-        p[3 * x] = (static_cast<float>(x) - cx) * ifx * z[x];
-        p[3 * x + 1] = ry * z[x];
-        p[3 * x + 2] = z[x];
-      }
-    }
+    for (int y = begin; y < end; ++y)
+      point_row(depth.ptr<float>(y), ray_x.data(), (static_cast<float>(y) - cy) * ify, depth.cols, points.ptr<float>(y));
   });
   return points;
 }
