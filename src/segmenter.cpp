@@ -74,8 +74,8 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   r.depth = depth;
   r.points = depth_to_points(depth, camera);                                     // point cloud
   watch.mark("pointcloud");
-  const NormalPlanes normals = compute_normal_planes(depth, camera, step, px.odd(p.normals.smooth_ksize), jump);
-  cv::merge(normals.data(), 3, r.normals);                                       // a) normals
+  NormalPlanes normals;
+  r.normals = compute_normals(depth, camera, step, px.odd(p.normals.smooth_ksize), jump, &normals);  // a) normals
   watch.mark("normals");
   r.edge_value = normal_edge_value(normals, edge_step);                          // b) normal edges
   r.edges = edge_mask(r.edge_value, r.depth, p.edges.theta, pixel_jump);
