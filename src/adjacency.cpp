@@ -29,9 +29,9 @@ bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
 // Seeds kept per pixel: one per patch, the nearest kMaxSeeds patches.
 constexpr int kMaxSeeds = 4;
 
-// A seed is a patch pixel, named by its image position; its point and label are read from the images
-// when needed (they lie within r pixels, so in cache). 12 bytes: the seed sets of all carriers of a
-// 640x480 frame fit in 5 MB.
+// A seed is a patch pixel, named by its image position and carrying its label; its 3D point is read
+// from the cloud when a distance is needed (it lies within r pixels, so in cache). 12 bytes: the seed
+// sets of all carriers of a 640x480 frame take about 3 MB.
 struct Seed {
   std::uint32_t yx;  // (y << 16) | x: one compare tells two seeds apart, and orders them as pixel indices
   int label;         // patch id 1..N

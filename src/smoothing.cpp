@@ -26,7 +26,7 @@ cv::Mat depth_to_metres(const cv::Mat& depth, const Camera& camera) {
 namespace {
 
 // Median of the valid (> 0) values among the 3x3 neighbours of (x, y), for a pixel next to a hole or
-// the image border (insertion sort: at most 8 values).
+// the image border (insertion sort of at most 9 values).
 float median_of_valid_neighbours(const cv::Mat& depth, int x, int y) {
   float v[9];
   int n = 0;
