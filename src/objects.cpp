@@ -313,17 +313,18 @@ void for_each_run(const cv::Mat& object_labels, int num_objects, Visit visit) {
 }
 
 // Sums over the valid points of a run, relative to `origin`: n, then x, y, z, then xx, xy, xz, yy, yz, zz.
-// Vectorised (float lanes, OpenMP simd); relative to a point of the object the values are centimetres,
-// so float sums of a run (at most one image row) lose nothing that matters.
-CLUTTERSEG_ROW_KERNEL void centred_sums(const float* __restrict xyz, int count, const float* __restrict origin,
+// Coordinates come as planes (x, y, z), so that the loop vectorises (float lanes, OpenMP simd); relative
+// to a point of the object the values are centimetres, so float sums of a run (at most one image row)
+// lose nothing that matters.
+CLUTTERSEG_ROW_KERNEL void centred_sums(const float* __restrict px, const float* __restrict py,
+                                        const float* __restrict pz, int count, const float* __restrict origin,
                                         double* __restrict total) {
   float n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
   const float ox = origin[0], oy = origin[1], oz = origin[2];
 #pragma omp simd reduction(+ : n, x, y, z, xx, xy, xz, yy, yz, zz)
   for (int k = 0; k < count; ++k) {
-    const bool valid = xyz[3 * k + 2] > 0;
-    const float dx = valid ? xyz[3 * k] - ox : 0.f, dy = valid ? xyz[3 * k + 1] - oy : 0.f;
-    const float dz = valid ? xyz[3 * k + 2] - oz : 0.f;
+    const bool valid = pz[k] > 0;
+    const float dx = valid ? px[k] - ox : 0.f, dy = valid ? py[k] - oy : 0.f, dz = valid ? pz[k] - oz : 0.f;
     n += valid ? 1.f : 0.f;
     x += dx; y += dy; z += dz;
     xx += dx * dx; xy += dx * dy; xz += dx * dz; yy += dy * dy; yz += dy * dz; zz += dz * dz;
@@ -332,8 +333,10 @@ CLUTTERSEG_ROW_KERNEL void centred_sums(const float* __restrict xyz, int count, 
   for (int k = 0; k < 10; ++k) total[k] += run[k];
 }
 
-// Lowest and highest values of axes * p over the valid points of a run (axes: row-major 3x3).
-CLUTTERSEG_ROW_KERNEL void extents_along(const float* __restrict xyz, int count, const float* __restrict axes,
+// Lowest and highest values of axes * p over the valid points of a run (axes: row-major 3x3; points as
+// planes).
+CLUTTERSEG_ROW_KERNEL void extents_along(const float* __restrict px, const float* __restrict py,
+                                         const float* __restrict pz, int count, const float* __restrict axes,
                                          float* __restrict low, float* __restrict high) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   float lo0 = low[0], lo1 = low[1], lo2 = low[2], hi0 = high[0], hi1 = high[1], hi2 = high[2];
@@ -341,10 +344,9 @@ CLUTTERSEG_ROW_KERNEL void extents_along(const float* __restrict xyz, int count,
   const float a20 = axes[6], a21 = axes[7], a22 = axes[8];
 #pragma omp simd reduction(min : lo0, lo1, lo2) reduction(max : hi0, hi1, hi2)
   for (int k = 0; k < count; ++k) {
-    const float px = xyz[3 * k], py = xyz[3 * k + 1], pz = xyz[3 * k + 2];
-    const bool valid = pz > 0;
-    const float c0 = a00 * px + a01 * py + a02 * pz, c1 = a10 * px + a11 * py + a12 * pz;
-    const float c2 = a20 * px + a21 * py + a22 * pz;
+    const bool valid = pz[k] > 0;
+    const float c0 = a00 * px[k] + a01 * py[k] + a02 * pz[k], c1 = a10 * px[k] + a11 * py[k] + a12 * pz[k];
+    const float c2 = a20 * px[k] + a21 * py[k] + a22 * pz[k];
     lo0 = std::min(lo0, valid ? c0 : kInf); hi0 = std::max(hi0, valid ? c0 : -kInf);
     lo1 = std::min(lo1, valid ? c1 : kInf); hi1 = std::max(hi1, valid ? c1 : -kInf);
     lo2 = std::min(lo2, valid ? c2 : kInf); hi2 = std::max(hi2, valid ? c2 : -kInf);
@@ -359,13 +361,13 @@ struct Moments {
   std::array<float, 3> origin{};
   bool has_origin = false;
   std::array<double, 10> sums{};  // n, x, y, z, xx, xy, xz, yy, yz, zz
-  void add_run(const cv::Vec3f* p, int count) {
+  void add_run(const float* x, const float* y, const float* z, int count) {
     for (int k = 0; !has_origin && k < count; ++k)
-      if (p[k][2] > 0) {
-        origin = {p[k][0], p[k][1], p[k][2]};
+      if (z[k] > 0) {
+        origin = {x[k], y[k], z[k]};
         has_origin = true;
       }
-    if (has_origin) centred_sums(&p[0][0], count, origin.data(), sums.data());
+    if (has_origin) centred_sums(x, y, z, count, origin.data(), sums.data());
   }
   int valid() const { return static_cast<int>(sums[0]); }
 };
@@ -374,13 +376,18 @@ struct Moments {
 // cut cost and flags are left alone). Two passes: moments give the axes, then extents along them.
 void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo, const cv::Mat& object_labels,
                      const cv::Mat& points, const Camera& camera) {
-  const auto* pts = points.ptr<cv::Vec3f>();
+  // Coordinates as planes: the per-run loops below read them contiguously (and vectorise).
+  cv::Mat planes[3];
+  cv::split(points, planes);
+  const float* px = planes[0].ptr<float>();
+  const float* py = planes[1].ptr<float>();
+  const float* pz = planes[2].ptr<float>();
   const int num_objects = static_cast<int>(objects.size());
   std::vector<Moments> moments(objects.size());
   for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
     if (!redo[static_cast<size_t>(o)]) return;
     objects[static_cast<size_t>(o)].pixel_count += end - begin;
-    moments[static_cast<size_t>(o)].add_run(pts + begin, end - begin);
+    moments[static_cast<size_t>(o)].add_run(px + begin, py + begin, pz + begin, end - begin);
   });
   // Axes in the camera frame (rows of axes_t); float extents are plenty for millimetres at a few metres.
   const Eigen::Matrix3d rot = camera.camera_to_robot.topLeftCorner<3, 3>();
@@ -406,7 +413,7 @@ void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo
   std::vector<Eigen::Vector3f> high(objects.size(), Eigen::Vector3f::Constant(-kInf));
   for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
     if (!redo[static_cast<size_t>(o)]) return;
-    extents_along(&pts[begin][0], end - begin, axes_t[static_cast<size_t>(o)].data(), low[static_cast<size_t>(o)].data(),
+    extents_along(px + begin, py + begin, pz + begin, end - begin, axes_t[static_cast<size_t>(o)].data(), low[static_cast<size_t>(o)].data(),
                   high[static_cast<size_t>(o)].data());
   });
   for (size_t o = 0; o < objects.size(); ++o) {
