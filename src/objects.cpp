@@ -91,13 +91,19 @@ std::vector<cv::Point2f> convex_hull(const std::vector<cv::Point2f>& points) {
   // Extreme points along x, y, x + y and x - y, in counter-clockwise order of direction: the first
   // point reaching the largest projection.
   constexpr float kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1}, kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+  std::array<float, 8> largest;
+  for (int k = 0; k < 8; ++k) largest[static_cast<size_t>(k)] = largest_projection(xs.data(), ys.data(), n, kDx[k], kDy[k]);
+  std::array<int, 8> first;
+  first.fill(-1);
+  for (int i = 0, found = 0; i < n && found < 8; ++i)  // one scan for all 8: the first point at each maximum
+    for (int k = 0; k < 8; ++k)
+      if (first[static_cast<size_t>(k)] < 0 &&
+          kDx[k] * xs[static_cast<size_t>(i)] + kDy[k] * ys[static_cast<size_t>(i)] >= largest[static_cast<size_t>(k)]) {
+        first[static_cast<size_t>(k)] = i;
+        ++found;
+      }
   std::array<cv::Point2f, 8> extreme;
-  for (int k = 0; k < 8; ++k) {
-    const float largest = largest_projection(xs.data(), ys.data(), n, kDx[k], kDy[k]);
-    int first = 0;
-    while (first + 1 < n && kDx[k] * xs[static_cast<size_t>(first)] + kDy[k] * ys[static_cast<size_t>(first)] < largest) ++first;
-    extreme[static_cast<size_t>(k)] = points[static_cast<size_t>(first)];
-  }
+  for (int k = 0; k < 8; ++k) extreme[static_cast<size_t>(k)] = points[static_cast<size_t>(std::max(first[static_cast<size_t>(k)], 0))];
   std::vector<cv::Point2f> polygon;
   for (const cv::Point2f& e : extreme)
     if (polygon.empty() || e != polygon.back()) polygon.push_back(e);
