@@ -46,17 +46,23 @@ const Input& frames(int subsample) {
   return cache[subsample] = in;
 }
 
-// Runs `body` on every frame per iteration and reports time per frame.
-template <typename Body>
-void per_frame(benchmark::State& state, Body body) {
+// Runs `body` on every input per iteration and reports the time per frame.
+template <typename Input, typename Body>
+void time_per_frame(benchmark::State& state, const std::vector<Input>& inputs, const Camera& camera, Body body) {
   set_threads(1);
   keep_freed_memory();  // as a Segmenter does
-  const Input& in = frames(static_cast<int>(state.range(0)));
   for (auto _ : state)
-    for (const auto& d : in.depth) benchmark::DoNotOptimize(body(d, in.camera));
+    for (const auto& input : inputs) benchmark::DoNotOptimize(body(input, camera));
   // Seconds of CPU per frame (shown with an SI prefix: 3.2m = 3.2 ms).
-  state.counters["per_frame"] = benchmark::Counter(static_cast<double>(state.iterations() * in.depth.size()),
+  state.counters["per_frame"] = benchmark::Counter(static_cast<double>(state.iterations() * inputs.size()),
                                                    benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// The frames' depth (argument: subsampling) as input.
+template <typename Body>
+void per_frame(benchmark::State& state, Body body) {
+  const Input& in = frames(static_cast<int>(state.range(0)));
+  time_per_frame(state, in.depth, in.camera, body);
 }
 
 const Params kParams;
@@ -82,6 +88,7 @@ void Normals(benchmark::State& s) {
 // The inputs of the later stages, computed once per frame (outside the timed loop).
 struct Stages {
   cv::Mat depth, points, normals, edges;
+  NormalPlanes normal_planes;  // the layout the pipeline hands to the edge stage
   Patches patches;
 };
 const std::vector<Stages>& stages(int subsample) {
@@ -97,8 +104,8 @@ const std::vector<Stages>& stages(int subsample) {
     s.depth = median_depth(raw);
     s.points = depth_to_points(s.depth, in.camera);
     s.normals = compute_normals(s.depth, in.camera, step, px.odd(kParams.normals.smooth_ksize),
-                                relative_jump_limit(kParams.edges, step, in.camera));
-    s.edges = edge_mask(normal_edge_value(s.normals, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
+                                relative_jump_limit(kParams.edges, step, in.camera), &s.normal_planes);
+    s.edges = edge_mask(normal_edge_value(s.normal_planes, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
                         relative_jump_limit(kParams.edges, 1, in.camera));
     s.patches = extract_patches(s.edges, s.points, s.normals, kParams.patches, px.area(kParams.patches.min_size_px));
     out.push_back(std::move(s));
@@ -106,23 +113,16 @@ const std::vector<Stages>& stages(int subsample) {
   return cache[subsample] = out;
 }
 
-// Runs `body` on every frame's precomputed stages per iteration.
+// The frames' precomputed stages (argument: subsampling) as input.
 template <typename Body>
 void per_stage_frame(benchmark::State& state, Body body) {
-  set_threads(1);
-  keep_freed_memory();
-  const Input& in = frames(static_cast<int>(state.range(0)));
-  const auto& all = stages(static_cast<int>(state.range(0)));
-  for (auto _ : state)
-    for (const auto& s : all) benchmark::DoNotOptimize(body(s, in.camera));
-  state.counters["per_frame"] = benchmark::Counter(static_cast<double>(state.iterations() * all.size()),
-                                                   benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  time_per_frame(state, stages(static_cast<int>(state.range(0))), frames(static_cast<int>(state.range(0))).camera, body);
 }
 
 void Edges(benchmark::State& st) {
   per_stage_frame(st, [](const Stages& s, const Camera& c) {
     const PixelScale px(c.fx, c.fy);
-    return edge_mask(normal_edge_value(s.normals, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
+    return edge_mask(normal_edge_value(s.normal_planes, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
                      relative_jump_limit(kParams.edges, 1, c));
   });
 }
@@ -151,9 +151,10 @@ void Presegmentation(benchmark::State& s) {
     const int step = px.length(kParams.normals.step_px), edge_step = px.length(kParams.edges.step_px);
     const cv::Mat depth = t.push(median_depth(raw), kParams.smoothing);
     const cv::Mat points = depth_to_points(depth, c);
+    NormalPlanes planes;
     const cv::Mat normals = compute_normals(depth, c, step, px.odd(kParams.normals.smooth_ksize),
-                                            relative_jump_limit(kParams.edges, step, c));
-    const cv::Mat edges = edge_mask(normal_edge_value(normals, edge_step), depth, kParams.edges.theta,
+                                            relative_jump_limit(kParams.edges, step, c), &planes);
+    const cv::Mat edges = edge_mask(normal_edge_value(planes, edge_step), depth, kParams.edges.theta,
                                     relative_jump_limit(kParams.edges, 1, c));
     return extract_patches(edges, points, normals, kParams.patches, px.area(kParams.patches.min_size_px)).patches.size();
   });

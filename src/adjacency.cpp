@@ -24,8 +24,6 @@ namespace clutterseg {
 
 namespace {
 
-bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
-
 // Seeds kept per pixel: one per patch, the nearest kMaxSeeds patches.
 constexpr int kMaxSeeds = 4;
 

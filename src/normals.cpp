@@ -19,28 +19,6 @@ CLUTTERSEG_ROW_KERNEL void point_row(const float* __restrict z, const float* __r
   }
 }
 
-}  // namespace
-
-cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera) {
-  cv::Mat points(depth.size(), CV_32FC3);
-  const float ifx = static_cast<float>(1.0 / camera.fx), ify = static_cast<float>(1.0 / camera.fy);
-  const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
-  std::vector<float> ray_x(static_cast<size_t>(depth.cols));
-  for (int x = 0; x < depth.cols; ++x) ray_x[static_cast<size_t>(x)] = (static_cast<float>(x) - cx) * ifx;
-  parallel_for_rows(depth.rows, [&](int begin, int end) {
-    for (int y = begin; y < end; ++y)
-      point_row(depth.ptr<float>(y), ray_x.data(), (static_cast<float>(y) - cy) * ify, depth.cols, points.ptr<float>(y));
-  });
-  return points;
-}
-
-float relative_jump_limit(const Params::Edges& params, int step, const Camera& camera) {
-  // Lateral distance of pixels `step` apart at depth z is z * step / f.
-  return static_cast<float>(params.jump_slope * step / std::min(camera.fx, camera.fy));
-}
-
-namespace {
-
 // One row of raw normals. Plain pointers and values (no captures) so that the loop vectorises.
 CLUTTERSEG_ROW_KERNEL void raw_normal_row(const float* __restrict up, const float* __restrict mid, const float* __restrict down,
                     const float* __restrict rx, float ry, float ry_up, float ry_down, int cols, int s,
@@ -88,6 +66,24 @@ CLUTTERSEG_ROW_KERNEL void normalize_row(const float* __restrict z, int cols, fl
 }
 
 }  // namespace
+
+cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera) {
+  cv::Mat points(depth.size(), CV_32FC3);
+  const float ifx = static_cast<float>(1.0 / camera.fx), ify = static_cast<float>(1.0 / camera.fy);
+  const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  std::vector<float> ray_x(static_cast<size_t>(depth.cols));
+  for (int x = 0; x < depth.cols; ++x) ray_x[static_cast<size_t>(x)] = (static_cast<float>(x) - cx) * ifx;
+  parallel_for_rows(depth.rows, [&](int begin, int end) {
+    for (int y = begin; y < end; ++y)
+      point_row(depth.ptr<float>(y), ray_x.data(), (static_cast<float>(y) - cy) * ify, depth.cols, points.ptr<float>(y));
+  });
+  return points;
+}
+
+float relative_jump_limit(const Params::Edges& params, int step, const Camera& camera) {
+  // Lateral distance of pixels `step` apart at depth z is z * step / f.
+  return static_cast<float>(params.jump_slope * step / std::min(camera.fx, camera.fy));
+}
 
 cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit,
                         NormalPlanes* planes_out) {

@@ -17,8 +17,6 @@ namespace clutterseg {
 
 namespace {
 
-bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
-
 Eigen::Vector3d to_eigen(const cv::Vec3f& p) { return {p[0], p[1], p[2]}; }
 
 // Least-squares plane of a pixel list (at most ~3000 of them used), normal facing the camera.

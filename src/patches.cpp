@@ -7,16 +7,6 @@
 
 namespace clutterseg {
 
-std::vector<float> normal_histogram(const cv::Mat& normals, const std::vector<int>& pixels, int bins) {
-  std::vector<float> hist(static_cast<size_t>(bins * bins), 0.f);
-  if (pixels.empty()) return hist;
-  const auto* n = normals.ptr<cv::Vec3f>();
-  for (int i : pixels) hist[static_cast<size_t>(normal_bin(n[i], bins))] += 1.f;
-  const float inv = 1.f / static_cast<float>(pixels.size());
-  for (auto& h : hist) h *= inv;
-  return hist;
-}
-
 namespace {
 
 // Sums over the pixels of one connected component, gathered run by run in one raster pass.

@@ -29,8 +29,6 @@ namespace clutterseg {
 
 namespace {
 
-bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && std::isfinite(p[2]); }
-
 struct Segment {
   size_t begin, end;  // its pixels in the list of all segments' pixels
   cv::Rect bbox;

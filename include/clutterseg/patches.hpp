@@ -22,6 +22,4 @@ inline int normal_bin(const cv::Vec3f& n, int bins) {
   return bin(n[1]) * bins + bin(n[0]);
 }
 
-// Normal (x, y) histogram of the given pixels: bins x bins shares summing to 1.
-std::vector<float> normal_histogram(const cv::Mat& normals, const std::vector<int>& pixels, int bins);
 }  // namespace clutterseg

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -26,6 +27,9 @@ struct Camera {
   double depth_unit_m = 0.001;  // metres per integer depth step (uint16 input)
   Eigen::Matrix4d camera_to_robot = Eigen::Matrix4d::Identity();  // pose for 3D outputs
 };
+
+// A point of an organized cloud (depth_to_points) that has a measurement: pixels without one are (0,0,0).
+inline bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && p[2] < std::numeric_limits<float>::infinity(); }
 
 // Checks intrinsics against an image; throws Error("<what>: ...") when they do not fit.
 void check_camera(const Camera& camera, int width, int height, const std::string& what);
