@@ -19,6 +19,9 @@
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
+#include <type_traits>
+
+#include "clutterseg/parallel.hpp"
 
 namespace clutterseg {
 
@@ -73,6 +76,14 @@ struct SeedSet {
   }
 };
 
+// 255 where the point has depth (finite z > 0; NaN compares false), else 0.
+CLUTTERSEG_ROW_KERNEL void mark_depth(const float* __restrict xyz, int total, uchar* __restrict out) {
+  for (int i = 0; i < total; ++i) {
+    const float z = xyz[3 * i + 2];
+    out[i] = (z > 0) & (z < std::numeric_limits<float>::infinity()) ? 255 : 0;
+  }
+}
+
 }  // namespace
 
 Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points, int num_patches,
@@ -94,11 +105,9 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   // pixels with depth and the pixels without depth next to one (seeds cross holes of 1-2 px inside an
   // edge band, but do not flood the large regions without depth).
   constexpr int kSource = -2, kNeither = -1;
-  cv::Mat depth_plane, has_depth, near_depth;
-  cv::extractChannel(points, depth_plane, 2);
-  has_depth = (depth_plane > 0) & (depth_plane < std::numeric_limits<float>::max());  // NaN compares false
+  cv::Mat has_depth(patch_labels.size(), CV_8U), near_depth;
+  mark_depth(&pts[0][0], total, has_depth.ptr<uchar>());
   cv::dilate(has_depth, near_depth, cv::Mat());
-  const cv::Mat patch_pixel = (patch_labels > 0) & (patch_labels <= num_patches) & has_depth;
   std::vector<int> role(static_cast<size_t>(total), kNeither);
   struct Carrier {
     int i;
@@ -106,12 +115,12 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   };
   std::vector<Carrier> carriers;
   for (int y = 0; y < height; ++y) {
-    const uchar* source = patch_pixel.ptr<uchar>(y);
+    const uchar* depth = has_depth.ptr<uchar>(y);
     const uchar* near = near_depth.ptr<uchar>(y);
     const int* l = patch_labels.ptr<int>(y);
     int* row_role = role.data() + static_cast<size_t>(y) * width;
     for (int x = 0; x < width; ++x) {
-      if (source[x]) {
+      if (l[x] > 0 && l[x] <= num_patches && depth[x]) {
         row_role[x] = kSource;
       } else if (l[x] == 0 && near[x]) {
         row_role[x] = static_cast<int>(carriers.size());
@@ -124,7 +133,10 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   // Two raster passes (forward: from W, NW, N, NE; backward: from E, SE, S, SW), as in a chamfer
   // distance transform: a seed reaches every pixel within r along a path the passes follow.
   const int r2 = r * r;
-  auto gather = [&](const Carrier& c, const int (&from)[4][2]) {
+  // The pass is a compile-time constant, so the four offsets and their border tests are too.
+  static constexpr int kFrom[2][4][2] = {{{-1, 0}, {-1, -1}, {0, -1}, {1, -1}}, {{1, 0}, {1, 1}, {0, 1}, {-1, 1}}};
+  auto gather = [&](const Carrier& c, auto pass) {
+    constexpr auto& from = kFrom[decltype(pass)::value];
     const int x = c.x, y = c.y;
     SeedSet& own = seeds[static_cast<size_t>(role[static_cast<size_t>(c.i)])];
     const cv::Vec3f here = pts[c.i];
@@ -154,10 +166,8 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
       }
     }
   };
-  constexpr int kForward[4][2] = {{-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
-  constexpr int kBackward[4][2] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}};
-  for (const Carrier& c : carriers) gather(c, kForward);
-  for (auto it = carriers.rbegin(); it != carriers.rend(); ++it) gather(*it, kBackward);
+  for (const Carrier& c : carriers) gather(c, std::integral_constant<int, 0>{});
+  for (auto it = carriers.rbegin(); it != carriers.rend(); ++it) gather(*it, std::integral_constant<int, 1>{});
 
   // The paper's rule on each reached pixel with depth: seeds within d_max.
   int* assigned = out.labels.ptr<int>();

@@ -305,12 +305,7 @@ void for_each_run(const cv::Mat& object_labels, int num_objects, Visit visit) {
   const int* lab = object_labels.ptr<int>();
   const int total = static_cast<int>(object_labels.total());
   for (int begin = 0; begin < total;) {
-    const int id = lab[begin];
-    int end = begin + 1;
-    // Four labels per step; the OR of differences is 0 only when all four equal id (branch-free).
-    while (end + 4 <= total && ((lab[end] ^ id) | (lab[end + 1] ^ id) | (lab[end + 2] ^ id) | (lab[end + 3] ^ id)) == 0)
-      end += 4;
-    while (end < total && lab[end] == id) ++end;
+    const int id = lab[begin], end = run_end(lab, begin, total);
     if (id > 0 && id <= num_objects) visit(id - 1, begin, end);
     begin = end;
   }

@@ -5,6 +5,8 @@
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 
+#include "clutterseg/parallel.hpp"
+
 namespace clutterseg {
 
 namespace {
@@ -17,6 +19,11 @@ struct ComponentSums {
   std::vector<int> pixels;
   std::vector<int> histogram;  // bins x bins counts
 };
+
+// out[i] = new_id[in[i]] (a vectorised gather).
+CLUTTERSEG_ROW_KERNEL void relabel(const int* __restrict in, const int* __restrict new_id, int total, int* __restrict out) {
+  for (int i = 0; i < total; ++i) out[i] = new_id[in[i]];
+}
 
 }  // namespace
 
@@ -35,7 +42,7 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     for (int x = 0; x < cols;) {
       // One run of a component along the row: its pixels are contiguous in memory.
       const int c = comp[x], start = x;
-      while (x < cols && comp[x] == c) ++x;
+      x = run_end(comp, x, cols);
       if (c == 0) continue;
       ComponentSums& s = sums[static_cast<size_t>(c)];
       if (s.histogram.empty()) s.histogram.assign(static_cast<size_t>(bins * bins), 0);
@@ -87,7 +94,7 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
   const int total = static_cast<int>(edges.total());
   const int* comp = components.ptr<int>();
   int* lab = out.labels.ptr<int>();
-  for (int i = 0; i < total; ++i) lab[i] = new_id[static_cast<size_t>(comp[i])];
+  relabel(comp, new_id.data(), total, lab);
   return out;
 }
 

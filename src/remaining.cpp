@@ -25,6 +25,8 @@
 #include <limits>
 #include <span>
 
+#include "clutterseg/parallel.hpp"
+
 namespace clutterseg {
 
 namespace {
@@ -43,6 +45,26 @@ constexpr uchar kRemaining = 1, kGrown = 2, kInSegment = 3, kInRing = 0x80;
 int next_remaining(const std::vector<uchar>& state, int from) {
   const auto* found = static_cast<const uchar*>(std::memchr(state.data() + from, kRemaining, state.size() - static_cast<size_t>(from)));
   return static_cast<int>(found ? found - state.data() : static_cast<std::ptrdiff_t>(state.size()));
+}
+
+// Object id of every pixel (obj) and the remaining pixels: no patch but a valid point (state =
+// kRemaining). Returns their count; *max_label = the largest label seen. Branch-free, one vectorised
+// pass (labels and depth are noisy at edges; the lookup is a gather).
+CLUTTERSEG_ROW_KERNEL int mark_remaining(const int* __restrict lab, const float* __restrict xyz,
+                                         const int* __restrict object_of_label, int total, int num_patches,
+                                         int* __restrict obj, uchar* __restrict state, int* __restrict max_label) {
+  int count = 0, largest = 0;
+  for (int i = 0; i < total; ++i) {
+    const int l = lab[i];
+    largest = std::max(largest, l);
+    obj[i] = object_of_label[std::clamp(l, 0, num_patches)];  // out of range is reported by the caller
+    const float z = xyz[3 * i + 2];
+    const bool remaining = (l == 0) & (z > 0) & (z < std::numeric_limits<float>::infinity());
+    state[i] = remaining ? kRemaining : 0;
+    count += remaining;
+  }
+  *max_label = largest;
+  return count;
 }
 
 constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
@@ -114,15 +136,9 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   int* obj = objects.ptr<int>();
   // Remaining pixels (no patch, valid) are marked once, so the growing below reads one byte per pixel.
   std::vector<uchar> state(static_cast<size_t>(total), 0);
-  size_t num_remaining = 0;
   int max_label = 0;
-  for (int i = 0; i < total; ++i) {  // branch-free (& not &&): labels and depth are noisy at edges
-    max_label = std::max(max_label, lab[i]);
-    obj[i] = object_of_label[static_cast<size_t>(std::clamp(lab[i], 0, num_patches))];  // checked below
-    const bool remaining = (lab[i] == 0) & (pts[i][2] > 0) & (pts[i][2] < std::numeric_limits<float>::infinity());
-    state[static_cast<size_t>(i)] = remaining ? kRemaining : 0;
-    num_remaining += remaining;
-  }
+  const size_t num_remaining = static_cast<size_t>(mark_remaining(lab, &pts[0][0], object_of_label.data(), total, num_patches,
+                                                                  obj, state.data(), &max_label));
   if (max_label > num_patches) throw Error("assign_remaining: patch label out of range");
 
   // Region growing of the remaining pixels. The pixels of all segments are stored one after another

@@ -31,6 +31,17 @@ struct Camera {
 // A point of an organized cloud (depth_to_points) that has a measurement: pixels without one are (0,0,0).
 inline bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && p[2] < std::numeric_limits<float>::infinity(); }
 
+// End of the run of labels equal to lab[begin] within [begin, end). Label images come in long runs
+// (the row segments of patches and objects): four labels per step, the OR of differences is 0 only
+// when all four match (branch-free).
+inline int run_end(const int* lab, int begin, int end) {
+  const int id = lab[begin];
+  int k = begin + 1;
+  while (k + 4 <= end && ((lab[k] ^ id) | (lab[k + 1] ^ id) | (lab[k + 2] ^ id) | (lab[k + 3] ^ id)) == 0) k += 4;
+  while (k < end && lab[k] == id) ++k;
+  return k;
+}
+
 // Checks intrinsics against an image; throws Error("<what>: ...") when they do not fit.
 void check_camera(const Camera& camera, int width, int height, const std::string& what);
 
