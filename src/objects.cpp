@@ -228,12 +228,29 @@ bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const 
   return n && static_cast<double>(in) / n >= share;
 }
 
-// Points within band of the plane (the same sum as Plane::distance, in a vectorised loop).
+// Points within band of the plane (Plane::distance up to rounding: the sum is in scan order, Eigen sums
+// the last two products first; a point exactly at the band edge can count differently).
 CLUTTERSEG_ROW_KERNEL int count_planar(const float* __restrict x, const float* __restrict y, const float* __restrict z,
                                        int n, float a, float b, float c, float offset, float band) {
   int count = 0;
   for (int k = 0; k < n; ++k) count += std::abs(a * x[k] + b * y[k] + c * z[k] + offset) <= band;
   return count;
+}
+
+// out[k] = value where point k (interleaved xyz) is valid and lies above the plane by more than `low`
+// and at most `high` (Plane::distance, in a vectorised loop); other entries unchanged.
+CLUTTERSEG_ROW_KERNEL void mark_between(const float* __restrict xyz, int n, float a, float b, float c, float offset,
+                                        double low, double high, uchar value, uchar* __restrict out) {
+  for (int k = 0; k < n; ++k) {
+    const float x = xyz[3 * k], y = xyz[3 * k + 1], z = xyz[3 * k + 2];
+    const float h = a * x + (b * y + c * z) + offset;  // Eigen's order for a 3-vector dot: same bits
+    const bool valid = (z > 0) & (z < std::numeric_limits<float>::infinity());
+    out[k] = valid ? ((static_cast<double>(h) > low) & (static_cast<double>(h) <= high) ? value : 0) : out[k];
+  }
+}
+
+void mark_above(const float* xyz, int n, const Plane& plane, double low, double high, uchar value, uchar* out) {
+  mark_between(xyz, n, plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset, low, high, value, out);
 }
 
 int count_within(const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
@@ -383,8 +400,13 @@ void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo
   const float* pz = planes[2].ptr<float>();
   const int num_objects = static_cast<int>(objects.size());
   std::vector<Moments> moments(objects.size());
+  struct Run {
+    int object, begin, end;
+  };
+  std::vector<Run> runs;  // of the objects to redo, for the second pass
   for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
     if (!redo[static_cast<size_t>(o)]) return;
+    runs.push_back({o, begin, end});
     objects[static_cast<size_t>(o)].pixel_count += end - begin;
     moments[static_cast<size_t>(o)].add_run(px + begin, py + begin, pz + begin, end - begin);
   });
@@ -410,11 +432,10 @@ void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo
   constexpr float kInf = std::numeric_limits<float>::infinity();
   std::vector<Eigen::Vector3f> low(objects.size(), Eigen::Vector3f::Constant(kInf));
   std::vector<Eigen::Vector3f> high(objects.size(), Eigen::Vector3f::Constant(-kInf));
-  for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
-    if (!redo[static_cast<size_t>(o)]) return;
-    extents_along(px + begin, py + begin, pz + begin, end - begin, axes_t[static_cast<size_t>(o)].data(), low[static_cast<size_t>(o)].data(),
-                  high[static_cast<size_t>(o)].data());
-  });
+  for (const auto& [o, begin, end] : runs) {
+    const auto k = static_cast<size_t>(o);
+    extents_along(px + begin, py + begin, pz + begin, end - begin, axes_t[k].data(), low[k].data(), high[k].data());
+  }
   for (size_t o = 0; o < objects.size(); ++o) {
     if (!redo[o] || moments[o].valid() == 0) continue;
     // Axes ordered by extent, largest first, and right-handed.
@@ -614,12 +635,8 @@ int split_support(cv::Mat& object_labels, std::vector<Object>& objects, const Pl
   cv::Mat clear(object_labels.size(), CV_8U, cv::Scalar(0));
   uchar* mask = clear.ptr<uchar>();
   for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
-    if (!objects[static_cast<size_t>(o)].support) return;
-    for (int i = begin; i < end; ++i) {
-      if (!valid_point(pts[i])) continue;
-      const float h = table.distance(Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]));
-      mask[i] = h > params.plane_band && h <= params.max_height ? kClear : 0;
-    }
+    if (objects[static_cast<size_t>(o)].support)
+      mark_above(&pts[begin][0], end - begin, table, params.plane_band, params.max_height, kClear, mask + begin);
   });
   // Groups: 8-connected, and neighbours closer than plane_band in 3D (a box in front of a keyboard is
   // not one object with it). Each pixel enters the queue once: bounded.
@@ -639,10 +656,12 @@ int split_support(cv::Mat& object_labels, std::vector<Object>& objects, const Pl
     mask[start] = kQueued;
     for (size_t head = 0; head < queue.size(); ++head) {
       const int i = queue[head], x = i % width, y = i / width;
+      const bool interior = x > 0 && y > 0 && x + 1 < width && y + 1 < height;  // no border tests
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int xx = x + dx, yy = y + dy, j = yy * width + xx;
-          if (xx < 0 || yy < 0 || xx >= width || yy >= height || mask[j] != kClear) continue;
+          if (!interior && (xx < 0 || yy < 0 || xx >= width || yy >= height)) continue;
+          if (mask[j] != kClear) continue;
           const cv::Vec3f d = pts[i] - pts[j];
           if (d.dot(d) >= link2) continue;
           mask[j] = kQueued;
