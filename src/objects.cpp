@@ -237,6 +237,13 @@ CLUTTERSEG_ROW_KERNEL int count_planar(const float* __restrict x, const float* _
   return count;
 }
 
+// Valid points (finite z > 0) among n interleaved xyz points.
+CLUTTERSEG_ROW_KERNEL int count_valid(const float* __restrict xyz, int n) {
+  int count = 0;
+  for (int k = 0; k < n; ++k) count += (xyz[3 * k + 2] > 0) & (xyz[3 * k + 2] < std::numeric_limits<float>::infinity());
+  return count;
+}
+
 // out[k] = value where point k (interleaved xyz) is valid and lies above the plane by more than `low`
 // and at most `high` (Plane::distance, in a vectorised loop); other entries unchanged.
 CLUTTERSEG_ROW_KERNEL void mark_between(const float* __restrict xyz, int n, float a, float b, float c, float offset,
@@ -503,10 +510,17 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
       valid_total += end - begin;
       const int stride = std::max(1, objects[static_cast<size_t>(o)].pixel_count / kSamplesPerObject);
       int& wait = countdown[static_cast<size_t>(o)];
+      auto& picked = samples[static_cast<size_t>(o)];
+      if (count_valid(&pts[begin][0], end - begin) == end - begin) {  // the common case: every stride-th pixel
+        int i = begin + wait;
+        for (; i < end; i += stride) picked.push_back(i);
+        wait = i - end;
+        return;
+      }
       for (int i = begin; i < end; ++i) {
         if (!valid_point(pts[i]) || wait-- > 0) continue;
         wait = stride - 1;
-        samples[static_cast<size_t>(o)].push_back(i);
+        picked.push_back(i);
       }
     });
   }
