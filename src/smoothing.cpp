@@ -1,10 +1,13 @@
 #include "clutterseg/smoothing.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <opencv2/imgproc.hpp>
+#include <utility>
+#include <vector>
 
 #include "clutterseg/parallel.hpp"
 
@@ -91,14 +94,40 @@ cv::Mat median_depth(const cv::Mat& depth) {
 
 namespace {
 
-// sum += v and count += 1 where v is a measurement within band_k * z^2 of the centre z.
-CLUTTERSEG_ROW_KERNEL void accumulate_within_band(const float* __restrict v, const float* __restrict centre, int cols,
+// sum += v and count += 1 over N frames (rows `v`, oldest first), where v is a measurement within
+// band_k * z^2 of the centre z. The N frames are summed in registers in that order, so the bits do
+// not depend on how the window is cut into chunks of N.
+template <int N>
+CLUTTERSEG_ROW_KERNEL void accumulate_within_band(const float* const* v, const float* __restrict centre, int cols,
                                                   float band_k, float* __restrict sum, float* __restrict count) {
+  const float* frame[N];
+  for (int i = 0; i < N; ++i) frame[i] = v[i];
   for (int x = 0; x < cols; ++x) {
-    const float z = centre[x];
-    const bool take = (v[x] > 0) & (std::abs(v[x] - z) <= band_k * z * z);
-    sum[x] += take ? v[x] : 0.f;
-    count[x] += take ? 1.f : 0.f;
+    const float z = centre[x], limit = band_k * z * z;
+    float s = sum[x], c = count[x];
+    for (int i = 0; i < N; ++i) {
+      const bool take = (frame[i][x] > 0) & (std::abs(frame[i][x] - z) <= limit);
+      s += take ? frame[i][x] : 0.f;
+      c += take ? 1.f : 0.f;
+    }
+    sum[x] = s;
+    count[x] = c;
+  }
+}
+
+// accumulate_within_band over any number of frames, up to kChunk per call (one kernel per count).
+constexpr int kChunk = 8;
+using AccumulateKernel = void (*)(const float* const*, const float*, int, float, float*, float*);
+template <size_t... I>
+constexpr std::array<AccumulateKernel, sizeof...(I)> accumulate_kernels(std::index_sequence<I...>) {
+  return {&accumulate_within_band<static_cast<int>(I) + 1>...};
+}
+void accumulate_within_band(const std::vector<const float*>& rows, const float* centre, int cols, float band_k,
+                            float* sum, float* count) {
+  static constexpr auto kKernels = accumulate_kernels(std::make_index_sequence<kChunk>{});
+  for (size_t first = 0; first < rows.size(); first += kChunk) {
+    const size_t n = std::min<size_t>(kChunk, rows.size() - first);
+    kKernels[n - 1](rows.data() + first, centre, cols, band_k, sum, count);
   }
 }
 
@@ -124,8 +153,10 @@ cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& pa
   parallel_for_rows(depth.rows, [&](int begin, int end) {
     const size_t cols = static_cast<size_t>(depth.cols);
     std::vector<float> sum(cols), count(cols), centre(cols);
+    std::vector<const float*> rows(static_cast<size_t>(n));
     for (int y = begin; y < end; ++y) {
       const float* newest = frames.back()->ptr<float>(y);
+      for (int i = 0; i < n; ++i) rows[static_cast<size_t>(i)] = frames[static_cast<size_t>(i)]->ptr<float>(y);
       float* o = out.ptr<float>(y);
       // Two passes: the band around the newest value finds the values of the same surface (moving
       // surfaces keep only the newest), then the band around their mean, a steadier centre than one
@@ -134,9 +165,7 @@ cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& pa
         const float* around = pass == 0 ? newest : centre.data();
         std::fill(sum.begin(), sum.end(), 0.f);
         std::fill(count.begin(), count.end(), 0.f);
-        for (int i = 0; i < n; ++i)
-          accumulate_within_band(frames[static_cast<size_t>(i)]->ptr<float>(y), around, depth.cols, band_k, sum.data(),
-                                 count.data());
+        accumulate_within_band(rows, around, depth.cols, band_k, sum.data(), count.data());
         mean_where_measured(newest, sum.data(), count.data(), depth.cols, pass == 0 ? centre.data() : o);
       }
     }
