@@ -2,6 +2,7 @@
 
 #include <climits>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 
@@ -20,6 +21,31 @@ struct ComponentSums {
   std::vector<int> histogram;  // bins x bins counts
 };
 
+// sum[d] += v[3 k + d] for the n interleaved 3-vectors v, in order (the bits of a plain loop). Each
+// vector is read as 4 floats and added as 4 doubles at once (the 4th lane is the next vector's first
+// value, discarded); the last vector is added alone, so nothing past v[3 n - 1] is read.
+CLUTTERSEG_ROW_KERNEL void add_run(const float* __restrict v, int n, double* __restrict sum) {
+  using Floats = float __attribute__((vector_size(16)));
+  using Doubles = double __attribute__((vector_size(32)));
+  Doubles total = {sum[0], sum[1], sum[2], 0};
+  for (int k = 0; k + 1 < n; ++k) {
+    Floats f;
+    std::memcpy(&f, v + 3 * k, sizeof f);
+    total += __builtin_convertvector(f, Doubles);
+  }
+  for (int d = 0; d < 3; ++d) sum[d] = total[d];
+  if (n > 0)
+    for (int d = 0; d < 3; ++d) sum[d] += v[3 * (n - 1) + d];
+}
+
+// normal_bin of each of n interleaved normals, in one vectorised pass.
+CLUTTERSEG_ROW_KERNEL void normal_bins(const float* __restrict normals, int n, int bins, int* __restrict out) {
+  for (int k = 0; k < n; ++k) {
+    const cv::Vec3f normal(normals[3 * k], normals[3 * k + 1], normals[3 * k + 2]);
+    out[k] = normal_bin(normal, bins);
+  }
+}
+
 // out[i] = new_id[in[i]] (a vectorised gather).
 CLUTTERSEG_ROW_KERNEL void relabel(const int* __restrict in, const int* __restrict new_id, int total, int* __restrict out) {
   for (int i = 0; i < total; ++i) out[i] = new_id[in[i]];
@@ -35,10 +61,12 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
   const int count = cv::connectedComponents(edges == 0, components, 4, CV_32S);
   const int bins = params.histogram_bins, cols = edges.cols;
   std::vector<ComponentSums> sums(static_cast<size_t>(count));
+  std::vector<int> bin(static_cast<size_t>(cols));  // histogram bin of each pixel of the row
   for (int y = 0; y < edges.rows; ++y) {
     const int* comp = components.ptr<int>(y);
     const auto* pts = points.ptr<cv::Vec3f>(y);
     const auto* nrm = normals.ptr<cv::Vec3f>(y);
+    normal_bins(&nrm[0][0], cols, bins, bin.data());
     for (int x = 0; x < cols;) {
       // One run of a component along the row: its pixels are contiguous in memory.
       const int c = comp[x], start = x;
@@ -54,13 +82,9 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
       const size_t first = s.pixels.size();
       s.pixels.resize(first + static_cast<size_t>(x - start));
       std::iota(s.pixels.begin() + static_cast<std::ptrdiff_t>(first), s.pixels.end(), y * cols + start);
-      for (int k = start; k < x; ++k) {
-        for (int d = 0; d < 3; ++d) {
-          s.point[d] += pts[k][d];
-          s.normal[d] += nrm[k][d];
-        }
-        ++s.histogram[static_cast<size_t>(normal_bin(nrm[k], bins))];
-      }
+      add_run(&pts[start][0], x - start, s.point);
+      add_run(&nrm[start][0], x - start, s.normal);
+      for (int k = start; k < x; ++k) ++s.histogram[static_cast<size_t>(bin[static_cast<size_t>(k)])];
     }
   }
 
