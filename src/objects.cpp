@@ -623,15 +623,15 @@ std::optional<Plane> find_support(std::vector<Object>& objects, const std::vecto
     // Other pieces of the table (split off by occluding objects) lie in its plane.
     if (h.in_band >= 0.8 * n) { object.support = true; continue; }
     if (h.above_max > 0.5 * n || h.below > 0.5 * n || h.over_region < 0.3 * n) { object.background = true; continue; }
-    // Walls: large and flat, standing roughly perpendicular to the table.
+    // Walls: large and flat, standing roughly perpendicular to the table (the size first: it is known).
+    if (object.box.extents(0) < params.wall_min_extent) continue;
     int largest = -1;
     for (int p : object.patches)
       if (largest < 0 || patches[static_cast<size_t>(p)].pixels.size() > patches[static_cast<size_t>(largest)].pixels.size()) largest = p;
     Plane own;
     if (largest >= 0 && fit_plane(patches[static_cast<size_t>(largest)].pixels, points, own) &&
         mostly_within(patches[static_cast<size_t>(largest)].pixels, points, own, params.plane_band, 0.9) &&
-        std::abs(own.normal.dot(up)) < std::cos(60.0 * M_PI / 180.0) &&
-        object.box.extents(0) >= params.wall_min_extent)
+        std::abs(own.normal.dot(up)) < std::cos(60.0 * M_PI / 180.0))
       object.background = true;
   }
   return plane;
