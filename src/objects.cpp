@@ -73,6 +73,27 @@ CLUTTERSEG_ROW_KERNEL float largest_projection(const float* __restrict x, const 
   return largest;
 }
 
+// Points with a * x + b * y >= value.
+CLUTTERSEG_ROW_KERNEL int count_at_least(const float* __restrict x, const float* __restrict y, int n, float a, float b,
+                                         float value) {
+  int count = 0;
+  for (int i = 0; i < n; ++i) count += a * x[i] + b * y[i] >= value;
+  return count;
+}
+
+// Index of the first point with a * x + b * y >= value (n if none): blocks are counted in a vectorised
+// pass, and only the block that holds it is scanned point by point.
+int first_at_least(const float* x, const float* y, int n, float a, float b, float value) {
+  constexpr int kBlock = 64;
+  for (int begin = 0; begin < n; begin += kBlock) {
+    const int end = std::min(n, begin + kBlock);
+    if (count_at_least(x + begin, y + begin, end - begin, a, b, value) == 0) continue;
+    for (int i = begin; i < end; ++i)
+      if (a * x[i] + b * y[i] >= value) return i;
+  }
+  return n;
+}
+
 // keep[i] &= (a * x + b * y > offset) for one edge of the inner polygon.
 CLUTTERSEG_ROW_KERNEL void keep_inside(const float* __restrict x, const float* __restrict y, int n, float a, float b,
                                        float offset, uchar* __restrict keep) {
@@ -91,17 +112,11 @@ std::vector<cv::Point2f> convex_hull(const std::vector<cv::Point2f>& points) {
   constexpr float kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1}, kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
   std::array<float, 8> largest;
   for (int k = 0; k < 8; ++k) largest[static_cast<size_t>(k)] = largest_projection(xs.data(), ys.data(), n, kDx[k], kDy[k]);
-  std::array<int, 8> first;
-  first.fill(-1);
-  for (int i = 0, found = 0; i < n && found < 8; ++i)  // one scan for all 8: the first point at each maximum
-    for (int k = 0; k < 8; ++k)
-      if (first[static_cast<size_t>(k)] < 0 &&
-          kDx[k] * xs[static_cast<size_t>(i)] + kDy[k] * ys[static_cast<size_t>(i)] >= largest[static_cast<size_t>(k)]) {
-        first[static_cast<size_t>(k)] = i;
-        ++found;
-      }
   std::array<cv::Point2f, 8> extreme;
-  for (int k = 0; k < 8; ++k) extreme[static_cast<size_t>(k)] = points[static_cast<size_t>(std::max(first[static_cast<size_t>(k)], 0))];
+  for (int k = 0; k < 8; ++k) {
+    const int first = first_at_least(xs.data(), ys.data(), n, kDx[k], kDy[k], largest[static_cast<size_t>(k)]);
+    extreme[static_cast<size_t>(k)] = points[static_cast<size_t>(first < n ? first : 0)];
+  }
   std::vector<cv::Point2f> polygon;
   for (const cv::Point2f& e : extreme)
     if (polygon.empty() || e != polygon.back()) polygon.push_back(e);
