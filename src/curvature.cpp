@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "clutterseg/occlusion.hpp"
+#include "clutterseg/parallel.hpp"
 #include "clutterseg/patches.hpp"
 
 namespace clutterseg {
@@ -29,22 +30,31 @@ int histogram_side(const std::vector<float>& histogram) {
 
 cv::Rect grown(const cv::Rect& r, int by) { return {r.x - by, r.y - by, r.width + 2 * by, r.height + 2 * by}; }
 
+// on_edge[x] = 1 where row[x] differs from one of its 8 neighbours (rows up and down), for 0 < x < cols - 1.
+CLUTTERSEG_ROW_KERNEL void differs_from_neighbours(const int* __restrict up, const int* __restrict row,
+                                                   const int* __restrict down, int cols, uchar* __restrict on_edge) {
+  for (int x = 1; x + 1 < cols; ++x) {
+    const int id = row[x];
+    on_edge[x] = (up[x - 1] != id) | (up[x] != id) | (up[x + 1] != id) | (row[x - 1] != id) | (row[x + 1] != id) |
+                 (down[x - 1] != id) | (down[x] != id) | (down[x + 1] != id);
+  }
+}
+
 // Per label (index id - 1, only where `wanted`), the pixels with an 8-neighbour outside the label:
 // one pass over the image. The two closest pixels of two disjoint patches are boundary pixels: from
 // an interior pixel, a step towards the other patch stays inside and gets closer.
 std::vector<std::vector<cv::Point>> boundaries(const cv::Mat& labels, const std::vector<char>& wanted) {
   std::vector<std::vector<cv::Point>> out(wanted.size());
-  const int max_id = static_cast<int>(wanted.size());
+  const int max_id = static_cast<int>(wanted.size()), cols = labels.cols;
+  std::vector<uchar> on_edge(static_cast<size_t>(cols), 1);  // image border pixels stay 1
   for (int y = 0; y < labels.rows; ++y) {
     const int* row = labels.ptr<int>(y);
-    const int* up = y > 0 ? labels.ptr<int>(y - 1) : nullptr;
-    const int* down = y + 1 < labels.rows ? labels.ptr<int>(y + 1) : nullptr;
-    for (int x = 0; x < labels.cols; ++x) {
+    const bool inner_row = y > 0 && y + 1 < labels.rows;
+    if (inner_row) differs_from_neighbours(labels.ptr<int>(y - 1), row, labels.ptr<int>(y + 1), cols, on_edge.data());
+    for (int x = 0; x < cols; ++x) {
+      if (inner_row && !on_edge[static_cast<size_t>(x)]) continue;
       const int id = row[x];
-      if (id <= 0 || id > max_id || !wanted[static_cast<size_t>(id - 1)]) continue;
-      bool edge = !up || !down || x == 0 || x + 1 == labels.cols;
-      for (int dx = -1; dx <= 1 && !edge; ++dx) edge = up[x + dx] != id || down[x + dx] != id || row[x + dx] != id;
-      if (edge) out[static_cast<size_t>(id - 1)].emplace_back(x, y);
+      if (id > 0 && id <= max_id && wanted[static_cast<size_t>(id - 1)]) out[static_cast<size_t>(id - 1)].emplace_back(x, y);
     }
   }
   return out;
