@@ -84,11 +84,11 @@ cv::Mat normal_edge_value(const NormalPlanes& n, int step) {
         if (x >= cols) break;
         float sum = 0;
         int count = 0;
+        const float a = n[0].ptr<float>(y)[x], b = n[1].ptr<float>(y)[x], c = n[2].ptr<float>(y)[x];
         for (const auto& d : kDirs) {
           const int xx = x + d[0] * step, yy = y + d[1] * step;
           if (xx < 0 || yy < 0 || xx >= cols || yy >= rows) continue;
-          sum += std::abs(n[0].ptr<float>(y)[x] * n[0].ptr<float>(yy)[xx] + n[1].ptr<float>(y)[x] * n[1].ptr<float>(yy)[xx] +
-                          n[2].ptr<float>(y)[x] * n[2].ptr<float>(yy)[xx]);
+          sum += std::abs(a * n[0].ptr<float>(yy)[xx] + b * n[1].ptr<float>(yy)[xx] + c * n[2].ptr<float>(yy)[xx]);
           ++count;
         }
         v[x] = sum / static_cast<float>(count);
