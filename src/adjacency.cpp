@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <type_traits>
@@ -84,6 +85,18 @@ CLUTTERSEG_ROW_KERNEL void mark_depth(const float* __restrict xyz, int total, uc
   }
 }
 
+// role = source where the pixel is a patch pixel with depth, else neither; carrier = 1 where it is no
+// patch pixel but has depth within one pixel (branch-free, one vectorised pass).
+CLUTTERSEG_ROW_KERNEL void mark_roles(const int* __restrict labels, const uchar* __restrict has_depth,
+                                      const uchar* __restrict near_depth, int total, int num_patches, int source,
+                                      int neither, int* __restrict role, uchar* __restrict carrier) {
+  for (int i = 0; i < total; ++i) {
+    const int l = labels[i];
+    role[i] = (l > 0) & (l <= num_patches) & (has_depth[i] != 0) ? source : neither;
+    carrier[i] = (l == 0) & (near_depth[i] != 0);
+  }
+}
+
 }  // namespace
 
 Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points, int num_patches,
@@ -108,25 +121,27 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   cv::Mat has_depth(patch_labels.size(), CV_8U), near_depth;
   mark_depth(&pts[0][0], total, has_depth.ptr<uchar>());
   cv::dilate(has_depth, near_depth, cv::Mat());
-  std::vector<int> role(static_cast<size_t>(total), kNeither);
+  std::vector<int> role(static_cast<size_t>(total));
+  std::vector<uchar> carrier(static_cast<size_t>(total));
+  mark_roles(lab, has_depth.ptr<uchar>(), near_depth.ptr<uchar>(), total, num_patches, kSource, kNeither, role.data(),
+             carrier.data());
   struct Carrier {
     int i;
     std::int16_t x, y;
   };
   std::vector<Carrier> carriers;
-  for (int y = 0; y < height; ++y) {
-    const uchar* depth = has_depth.ptr<uchar>(y);
-    const uchar* near = near_depth.ptr<uchar>(y);
-    const int* l = patch_labels.ptr<int>(y);
-    int* row_role = role.data() + static_cast<size_t>(y) * width;
-    for (int x = 0; x < width; ++x) {
-      if (l[x] > 0 && l[x] <= num_patches && depth[x]) {
-        row_role[x] = kSource;
-      } else if (l[x] == 0 && near[x]) {
-        row_role[x] = static_cast<int>(carriers.size());
-        carriers.push_back({y * width + x, static_cast<std::int16_t>(x), static_cast<std::int16_t>(y)});
+  for (int i = 0; i < total; ++i) {
+    if (i + 8 <= total) {  // eight pixels at a time where none is a carrier
+      std::uint64_t eight;
+      std::memcpy(&eight, carrier.data() + i, sizeof eight);
+      if (eight == 0) {
+        i += 7;
+        continue;
       }
     }
+    if (!carrier[static_cast<size_t>(i)]) continue;
+    role[static_cast<size_t>(i)] = static_cast<int>(carriers.size());
+    carriers.push_back({i, static_cast<std::int16_t>(i % width), static_cast<std::int16_t>(i / width)});
   }
   std::vector<SeedSet> seeds(carriers.size());
 
