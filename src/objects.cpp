@@ -266,17 +266,25 @@ CLUTTERSEG_ROW_KERNEL int count_valid(const float* __restrict xyz, int n) {
 // out[k] = value where point k (interleaved xyz) is valid and lies above the plane by more than `low`
 // and at most `high` (Plane::distance, in a vectorised loop); other entries unchanged.
 CLUTTERSEG_ROW_KERNEL void mark_between(const float* __restrict xyz, int n, float a, float b, float c, float offset,
-                                        double low, double high, uchar value, uchar* __restrict out) {
+                                        float low, float high, uchar value, uchar* __restrict out) {
   for (int k = 0; k < n; ++k) {
     const float x = xyz[3 * k], y = xyz[3 * k + 1], z = xyz[3 * k + 2];
     const float h = a * x + (b * y + c * z) + offset;  // Eigen's order for a 3-vector dot: same bits
     const bool valid = (z > 0) & (z < std::numeric_limits<float>::infinity());
-    out[k] = valid ? ((static_cast<double>(h) > low) & (static_cast<double>(h) <= high) ? value : 0) : out[k];
+    out[k] = valid ? ((h > low) & (h <= high) ? value : 0) : out[k];
   }
 }
 
+// The largest float <= v: for a float h, h > v and h <= v hold exactly when they hold for it, so a
+// comparison with a double threshold can stay in float lanes.
+float float_at_most(double v) {
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) > v ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+
 void mark_above(const float* xyz, int n, const Plane& plane, double low, double high, uchar value, uchar* out) {
-  mark_between(xyz, n, plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset, low, high, value, out);
+  mark_between(xyz, n, plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset, float_at_most(low),
+               float_at_most(high), value, out);
 }
 
 int count_within(const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
