@@ -54,7 +54,8 @@ std::vector<std::vector<cv::Point>> boundaries(const cv::Mat& labels, const std:
     for (int x = 0; x < cols; ++x) {
       if (inner_row && !on_edge[static_cast<size_t>(x)]) continue;
       const int id = row[x];
-      if (id > 0 && id <= max_id && wanted[static_cast<size_t>(id - 1)]) out[static_cast<size_t>(id - 1)].emplace_back(x, y);
+      if (id > 0 && id <= max_id && wanted[static_cast<size_t>(id - 1)])
+        out[static_cast<size_t>(id - 1)].emplace_back(x, y);
     }
   }
   return out;

@@ -47,7 +47,8 @@ CLUTTERSEG_ROW_KERNEL void normal_bins(const float* __restrict normals, int n, i
 }
 
 // out[i] = new_id[in[i]] (a vectorised gather).
-CLUTTERSEG_ROW_KERNEL void relabel(const int* __restrict in, const int* __restrict new_id, int total, int* __restrict out) {
+CLUTTERSEG_ROW_KERNEL void relabel(const int* __restrict in, const int* __restrict new_id, int total,
+                                   int* __restrict out) {
   for (int i = 0; i < total; ++i) out[i] = new_id[in[i]];
 }
 

@@ -137,8 +137,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   // Remaining pixels (no patch, valid) are marked once, so the growing below reads one byte per pixel.
   std::vector<uchar> state(static_cast<size_t>(total), 0);
   int max_label = 0;
-  const size_t num_remaining = static_cast<size_t>(mark_remaining(lab, &pts[0][0], object_of_label.data(), total, num_patches,
-                                                                  obj, state.data(), &max_label));
+  const auto num_remaining = static_cast<size_t>(
+      mark_remaining(lab, &pts[0][0], object_of_label.data(), total, num_patches, obj, state.data(), &max_label));
   if (max_label > num_patches) throw Error("assign_remaining: patch label out of range");
 
   // Region growing of the remaining pixels. The pixels of all segments are stored one after another
