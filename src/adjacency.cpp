@@ -77,12 +77,9 @@ struct SeedSet {
   }
 };
 
-// 255 where the point has depth (finite z > 0; NaN compares false), else 0.
+// 255 where the point (interleaved xyz) has depth, else 0.
 CLUTTERSEG_ROW_KERNEL void mark_depth(const float* __restrict xyz, int total, uchar* __restrict out) {
-  for (int i = 0; i < total; ++i) {
-    const float z = xyz[3 * i + 2];
-    out[i] = (z > 0) & (z < std::numeric_limits<float>::infinity()) ? 255 : 0;
-  }
+  for (int i = 0; i < total; ++i) out[i] = valid_depth(xyz[3 * i + 2]) ? 255 : 0;
 }
 
 // role = source where the pixel is a patch pixel with depth, else neither; carrier = 1 where it is no

@@ -61,9 +61,6 @@ struct PlaneRegion {
   }
 };
 
-// cv::convexHull of plane points. It sorts every point (~0.4 ms for the 4000 of a table); points more
-// than 1 mm inside the polygon of the extreme points in 8 directions cannot be hull vertices, so
-// dropping them first gives the same hull.
 // Largest a * x + b * y over the points, a and b in {-1, 0, 1} (exact: no rounding but the one sum).
 CLUTTERSEG_ROW_KERNEL float largest_projection(const float* __restrict x, const float* __restrict y, int n, float a,
                                                float b) {
@@ -100,6 +97,9 @@ CLUTTERSEG_ROW_KERNEL void keep_inside(const float* __restrict x, const float* _
   for (int i = 0; i < n; ++i) keep[i] &= static_cast<uchar>(a * x[i] + b * y[i] > offset);
 }
 
+// cv::convexHull of plane points. It sorts every point (~0.4 ms for the 4000 of a table); points more
+// than 1 mm inside the polygon of the extreme points in 8 directions cannot be hull vertices, so
+// dropping them first gives the same hull.
 std::vector<cv::Point2f> convex_hull(const std::vector<cv::Point2f>& points) {
   const int n = static_cast<int>(points.size());
   std::vector<float> xs(points.size()), ys(points.size());
@@ -256,10 +256,10 @@ CLUTTERSEG_ROW_KERNEL int count_planar(const float* __restrict x, const float* _
   return count;
 }
 
-// Valid points (finite z > 0) among n interleaved xyz points.
+// Valid points among n interleaved xyz points.
 CLUTTERSEG_ROW_KERNEL int count_valid(const float* __restrict xyz, int n) {
   int count = 0;
-  for (int k = 0; k < n; ++k) count += (xyz[3 * k + 2] > 0) & (xyz[3 * k + 2] < std::numeric_limits<float>::infinity());
+  for (int k = 0; k < n; ++k) count += valid_depth(xyz[3 * k + 2]);
   return count;
 }
 
@@ -270,8 +270,7 @@ CLUTTERSEG_ROW_KERNEL void mark_between(const float* __restrict xyz, int n, floa
   for (int k = 0; k < n; ++k) {
     const float x = xyz[3 * k], y = xyz[3 * k + 1], z = xyz[3 * k + 2];
     const float h = a * x + (b * y + c * z) + offset;  // Eigen's order for a 3-vector dot: same bits
-    const bool valid = (z > 0) & (z < std::numeric_limits<float>::infinity());
-    out[k] = valid ? ((h > low) & (h <= high) ? value : 0) : out[k];
+    out[k] = valid_depth(z) ? ((h > low) & (h <= high) ? value : 0) : out[k];
   }
 }
 
@@ -373,7 +372,7 @@ CLUTTERSEG_ROW_KERNEL void centred_sums(const float* __restrict px, const float*
   const float ox = origin[0], oy = origin[1], oz = origin[2];
 #pragma omp simd reduction(+ : n, x, y, z, xx, xy, xz, yy, yz, zz)
   for (int k = 0; k < count; ++k) {
-    const bool valid = pz[k] > 0;
+    const bool valid = valid_depth(pz[k]);
     const float dx = valid ? px[k] - ox : 0.f, dy = valid ? py[k] - oy : 0.f, dz = valid ? pz[k] - oz : 0.f;
     n += valid ? 1.f : 0.f;
     x += dx; y += dy; z += dz;
@@ -394,7 +393,7 @@ CLUTTERSEG_ROW_KERNEL void extents_along(const float* __restrict px, const float
   const float a20 = axes[6], a21 = axes[7], a22 = axes[8];
 #pragma omp simd reduction(min : lo0, lo1, lo2) reduction(max : hi0, hi1, hi2)
   for (int k = 0; k < count; ++k) {
-    const bool valid = pz[k] > 0;
+    const bool valid = valid_depth(pz[k]);
     const float c0 = a00 * px[k] + a01 * py[k] + a02 * pz[k], c1 = a10 * px[k] + a11 * py[k] + a12 * pz[k];
     const float c2 = a20 * px[k] + a21 * py[k] + a22 * pz[k];
     lo0 = std::min(lo0, valid ? c0 : kInf); hi0 = std::max(hi0, valid ? c0 : -kInf);
@@ -413,7 +412,7 @@ struct Moments {
   std::array<double, 10> sums{};  // n, x, y, z, xx, xy, xz, yy, yz, zz
   void add_run(const float* x, const float* y, const float* z, int count) {
     for (int k = 0; !has_origin && k < count; ++k)
-      if (z[k] > 0) {
+      if (valid_depth(z[k])) {
         origin = {x[k], y[k], z[k]};
         has_origin = true;
       }

@@ -59,7 +59,7 @@ CLUTTERSEG_ROW_KERNEL int mark_remaining(const int* __restrict lab, const float*
     largest = std::max(largest, l);
     obj[i] = object_of_label[std::clamp(l, 0, num_patches)];  // out of range is reported by the caller
     const float z = xyz[3 * i + 2];
-    const bool remaining = (l == 0) & (z > 0) & (z < std::numeric_limits<float>::infinity());
+    const bool remaining = (l == 0) & valid_depth(z);
     state[i] = remaining ? kRemaining : 0;
     count += remaining;
   }

@@ -28,8 +28,12 @@ struct Camera {
   Eigen::Matrix4d camera_to_robot = Eigen::Matrix4d::Identity();  // pose for 3D outputs
 };
 
+// A depth (the z of a cloud point) that is a measurement: finite and > 0 (NaN compares false). Branch-free,
+// so per-pixel loops that use it still vectorise.
+inline bool valid_depth(float z) { return (z > 0) & (z < std::numeric_limits<float>::infinity()); }
+
 // A point of an organized cloud (depth_to_points) that has a measurement: pixels without one are (0,0,0).
-inline bool valid_point(const cv::Vec3f& p) { return p[2] > 0 && p[2] < std::numeric_limits<float>::infinity(); }
+inline bool valid_point(const cv::Vec3f& p) { return valid_depth(p[2]); }
 
 // End of the run of labels equal to lab[begin] within [begin, end). Label images come in long runs
 // (the row segments of patches and objects): four labels per step, the OR of differences is 0 only
