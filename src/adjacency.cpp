@@ -17,7 +17,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <type_traits>
@@ -127,16 +126,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     std::int16_t x, y;
   };
   std::vector<Carrier> carriers;
-  for (int i = 0; i < total; ++i) {
-    if (i + 8 <= total) {  // eight pixels at a time where none is a carrier
-      std::uint64_t eight;
-      std::memcpy(&eight, carrier.data() + i, sizeof eight);
-      if (eight == 0) {
-        i += 7;
-        continue;
-      }
-    }
-    if (!carrier[static_cast<size_t>(i)]) continue;
+  for (int i = first_nonzero(carrier.data(), 0, total); i < total; i = first_nonzero(carrier.data(), i + 1, total)) {
     role[static_cast<size_t>(i)] = static_cast<int>(carriers.size());
     carriers.push_back({i, static_cast<std::int16_t>(i % width), static_cast<std::int16_t>(i / width)});
   }

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <opencv2/imgproc.hpp>
 #include <utility>
 #include <vector>
@@ -68,25 +66,16 @@ cv::Mat median_depth(const cv::Mat& depth) {
   // neither spreads nor drags a surface towards zero; holes stay holes.
   cv::Mat out;
   cv::medianBlur(depth, out, 3);
-  cv::Mat valid = depth > 0, inner;
-  cv::erode(valid, inner, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::Mat valid = depth > 0, redo;
+  cv::erode(valid, redo, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  redo = valid & ~redo;  // valid, but next to a hole or the border
   parallel_for_rows(depth.rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y) {
       float* o = out.ptr<float>(y);
-      const uchar* ok = valid.ptr<uchar>(y);
-      const uchar* far_from_hole = inner.ptr<uchar>(y);
-      keep_where(ok, depth.cols, o);
-      for (int x = 0; x < depth.cols;) {
-        // Eight pixels per step where none needs a redo (valid and far from holes, or invalid).
-        std::uint64_t has, far;
-        if (x + 8 <= depth.cols) {
-          std::memcpy(&has, ok + x, 8);
-          std::memcpy(&far, far_from_hole + x, 8);
-          if ((has & ~far) == 0) { x += 8; continue; }
-        }
-        if (ok[x] && !far_from_hole[x]) o[x] = median_of_valid_neighbours(depth, x, y);
-        ++x;
-      }
+      const uchar* r = redo.ptr<uchar>(y);
+      keep_where(valid.ptr<uchar>(y), depth.cols, o);
+      for (int x = first_nonzero(r, 0, depth.cols); x < depth.cols; x = first_nonzero(r, x + 1, depth.cols))
+        o[x] = median_of_valid_neighbours(depth, x, y);
     }
   });
   return out;

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -44,6 +45,19 @@ inline int run_end(const int* lab, int begin, int end) {
   while (k + 4 <= end && ((lab[k] ^ id) | (lab[k + 1] ^ id) | (lab[k + 2] ^ id) | (lab[k + 3] ^ id)) == 0) k += 4;
   while (k < end && lab[k] == id) ++k;
   return k;
+}
+
+// First index in [from, end) where bytes[i] != 0, or end. Masks with few set bytes (pixels next to holes,
+// edge carriers) are skipped eight bytes per step.
+inline int first_nonzero(const std::uint8_t* bytes, int from, int end) {
+  if (from < end && bytes[from]) return from;  // inside a run of set bytes
+  for (; from + 8 <= end; from += 8) {
+    std::uint64_t eight;
+    std::memcpy(&eight, bytes + from, sizeof eight);
+    if (eight) break;
+  }
+  while (from < end && !bytes[from]) ++from;
+  return from;
 }
 
 // Checks intrinsics against an image; throws Error("<what>: ...") when they do not fit.
