@@ -1,5 +1,5 @@
-// Pre-segmentation (paper a-c) per stage and in total, and edge-pixel assignment (paper d), one core, on the osd-kinect frames at 640x480
-// and 320x240. Run: ./build/bench/bench_presegmentation --benchmark_repetitions=5
+// Pre-segmentation (paper a-c) per stage and in total, and edge-pixel assignment (paper d), one core, on
+// the osd-kinect frames at 640x480 and 320x240. Run: ./build/bench/bench_presegmentation --benchmark_repetitions=5
 //   --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
