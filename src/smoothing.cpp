@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <utility>
 #include <vector>
@@ -29,26 +30,32 @@ cv::Mat depth_to_metres(const cv::Mat& depth, const Camera& camera) {
 namespace {
 
 // Median of the valid (> 0) values among the 3x3 neighbours of (x, y), for a pixel next to a hole or
-// the image border (insertion sort of at most 9 values).
+// the image border. The nine values go through a sorting network (Floyd's, 25 compare-exchanges), a
+// missing one as +inf so that it sorts last; the median of the n valid values is then element n / 2.
+// No branch depends on the data: around holes, which neighbours are valid is not predictable.
 float median_of_valid_neighbours(const cv::Mat& depth, int x, int y) {
+  constexpr float kMissing = std::numeric_limits<float>::infinity();
   float v[9];
   int n = 0;
-  auto insert = [&](float z) {
-    if (!(z > 0)) return;
-    int k = n++;
-    for (; k > 0 && v[k - 1] > z; --k) v[k] = v[k - 1];
-    v[k] = z;
-  };
-  if (x > 0 && y > 0 && x + 1 < depth.cols && y + 1 < depth.rows) {  // the common case: no clipping
-    for (int yy = y - 1; yy <= y + 1; ++yy) {
-      const float* row = depth.ptr<float>(yy) + x;
-      insert(row[-1]);
-      insert(row[0]);
-      insert(row[1]);
+  for (int dy = -1, k = 0; dy <= 1; ++dy) {
+    const int yy = std::clamp(y + dy, 0, depth.rows - 1);
+    for (int dx = -1; dx <= 1; ++dx, ++k) {
+      const int xx = std::clamp(x + dx, 0, depth.cols - 1);
+      const bool inside = yy == y + dy && xx == x + dx;
+      const float z = depth.ptr<float>(yy)[xx];
+      const bool valid = inside & (z > 0);
+      v[k] = valid ? z : kMissing;
+      n += valid;
     }
-  } else {
-    for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, depth.rows - 1); ++yy)
-      for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, depth.cols - 1); ++xx) insert(depth.ptr<float>(yy)[xx]);
+  }
+  static constexpr int kNetwork[25][2] = {{0, 1}, {3, 4}, {6, 7}, {1, 2}, {4, 5}, {7, 8}, {0, 1}, {3, 4}, {6, 7},
+                                          {0, 3}, {3, 6}, {0, 3}, {1, 4}, {4, 7}, {1, 4}, {2, 5}, {5, 8}, {2, 5},
+                                          {1, 3}, {5, 7}, {2, 6}, {4, 6}, {2, 4}, {2, 3}, {5, 6}};
+#pragma GCC unroll 25  // unrolled, v stays in registers
+  for (const auto& [a, b] : kNetwork) {
+    const float lo = std::min(v[a], v[b]), hi = std::max(v[a], v[b]);
+    v[a] = lo;
+    v[b] = hi;
   }
   return v[n / 2];  // n >= 1: the pixel itself is valid
 }
@@ -93,11 +100,15 @@ CLUTTERSEG_ROW_KERNEL void accumulate_within_band(const float* const* v, const f
   for (int i = 0; i < N; ++i) frame[i] = v[i];
   for (int x = 0; x < cols; ++x) {
     const float z = centre[x], limit = band_k * z * z;
+    // The band [lo, hi]; lo > 0, so that no missing measurement (0) falls in it.
+    const float lo = std::max(z - limit, std::numeric_limits<float>::denorm_min()), hi = z + limit;
     float s = sum[x], c = count[x];
     for (int i = 0; i < N; ++i) {
-      const bool take = (frame[i][x] > 0) & (std::abs(frame[i][x] - z) <= limit);
-      s += take ? frame[i][x] : 0.f;
-      c += take ? 1.f : 0.f;
+      const float v = frame[i][x];
+      const bool take = (v >= lo) & (v <= hi);
+      const float taken = take ? v : 0.f, one = take ? 1.f : 0.f;
+      s += taken;
+      c += one;
     }
     sum[x] = s;
     count[x] = c;
