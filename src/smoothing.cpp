@@ -60,9 +60,18 @@ float median_of_valid_neighbours(const cv::Mat& depth, int x, int y) {
   return v[n / 2];  // n >= 1: the pixel itself is valid
 }
 
-// v = 0 where mask is 0.
-CLUTTERSEG_ROW_KERNEL void keep_where(const uchar* __restrict mask, int cols, float* __restrict v) {
-  for (int x = 0; x < cols; ++x) v[x] = mask[x] ? v[x] : 0.f;
+// One row of the median's fix-up, columns [1, cols - 1): out = 0 where mid has no measurement (OpenCV's
+// median fills holes), and redo = 1 where mid has one but a 3x3 neighbour in up, mid or down has not.
+CLUTTERSEG_ROW_KERNEL void mark_hole_borders(const float* __restrict up, const float* __restrict mid,
+                                             const float* __restrict down, int cols, float* __restrict out,
+                                             uchar* __restrict redo) {
+  for (int x = 1; x + 1 < cols; ++x) {
+    const bool valid = mid[x] > 0;
+    const bool all_valid = (up[x - 1] > 0) & (up[x] > 0) & (up[x + 1] > 0) & (mid[x - 1] > 0) & (mid[x + 1] > 0) &
+                           (down[x - 1] > 0) & (down[x] > 0) & (down[x + 1] > 0);
+    out[x] = valid ? out[x] : 0.f;
+    redo[x] = valid & !all_valid;
+  }
 }
 
 }  // namespace
@@ -73,15 +82,22 @@ cv::Mat median_depth(const cv::Mat& depth) {
   // neither spreads nor drags a surface towards zero; holes stay holes.
   cv::Mat out;
   cv::medianBlur(depth, out, 3);
-  cv::Mat valid = depth > 0, redo;
-  cv::erode(valid, redo, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-  redo = valid & ~redo;  // valid, but next to a hole or the border
+  const int cols = depth.cols;
+  const std::vector<float> outside(static_cast<size_t>(cols), 0.f);  // the rows beyond the border: no data
   parallel_for_rows(depth.rows, [&](int begin, int end) {
+    std::vector<uchar> redo(static_cast<size_t>(cols));
     for (int y = begin; y < end; ++y) {
+      const float* mid = depth.ptr<float>(y);
+      const float* up = y > 0 ? depth.ptr<float>(y - 1) : outside.data();
+      const float* down = y + 1 < depth.rows ? depth.ptr<float>(y + 1) : outside.data();
       float* o = out.ptr<float>(y);
-      const uchar* r = redo.ptr<uchar>(y);
-      keep_where(valid.ptr<uchar>(y), depth.cols, o);
-      for (int x = first_nonzero(r, 0, depth.cols); x < depth.cols; x = first_nonzero(r, x + 1, depth.cols))
+      mark_hole_borders(up, mid, down, cols, o, redo.data());
+      for (const int x : {0, cols - 1}) {  // the first and last column: next to the border
+        redo[static_cast<size_t>(x)] = mid[x] > 0;
+        if (!(mid[x] > 0)) o[x] = 0.f;
+      }
+      const uchar* r = redo.data();
+      for (int x = first_nonzero(r, 0, cols); x < cols; x = first_nonzero(r, x + 1, cols))
         o[x] = median_of_valid_neighbours(depth, x, y);
     }
   });
