@@ -157,8 +157,13 @@ CLUTTERSEG_ROW_KERNEL void mean_where_measured(const float* __restrict newest, c
 
 cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& params) {
   if (!window_.empty() && window_.back().size() != depth.size()) window_.clear();
-  window_.push_back(depth.clone());
-  while (static_cast<int>(window_.size()) > std::max(1, params.temporal_frames)) window_.pop_front();
+  cv::Mat slot;  // the buffer of the frame that leaves the window takes the new one (no allocation)
+  while (static_cast<int>(window_.size()) >= std::max(1, params.temporal_frames)) {
+    slot = std::move(window_.front());
+    window_.pop_front();
+  }
+  depth.copyTo(slot);
+  window_.push_back(slot);
   if (window_.size() == 1) return depth.clone();
 
   cv::Mat out(depth.size(), CV_32F);
