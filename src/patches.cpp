@@ -12,7 +12,12 @@ namespace clutterseg {
 
 namespace {
 
-// Sums over the pixels of one connected component, gathered run by run in one raster pass.
+// One run of a connected component along an image row: its pixels are contiguous in memory.
+struct Run {
+  int component, y, x0, x1;  // columns [x0, x1)
+};
+
+// Sums over the pixels of one connected component.
 struct ComponentSums {
   int area = 0;
   int x0 = INT_MAX, y0 = INT_MAX, x1 = -1, y1 = -1;  // bounding box, inclusive
@@ -68,31 +73,43 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
   const int count = cv::connectedComponents(edges == 0, components, 4, CV_32S);
   const int bins = params.histogram_bins, cols = edges.cols;
   std::vector<ComponentSums> sums(static_cast<size_t>(count));
-  std::vector<int> bin(static_cast<size_t>(cols));  // histogram bin of each pixel of the row
+  // First the runs, with each component's area and box; then the statistics, only for the components
+  // that are large enough to become patches (most components are specks along the edges).
+  std::vector<Run> runs;
   for (int y = 0; y < edges.rows; ++y) {
     const int* comp = components.ptr<int>(y);
-    const auto* pts = points.ptr<cv::Vec3f>(y);
-    const auto* nrm = normals.ptr<cv::Vec3f>(y);
-    normal_bins(&nrm[0][0], cols, bins, bin.data());
     for (int x = 0; x < cols;) {
-      // One run of a component along the row: its pixels are contiguous in memory.
       const int c = comp[x], start = x;
       x = run_end(comp, x, cols);
       if (c == 0) continue;
+      runs.push_back({c, y, start, x});
       ComponentSums& s = sums[static_cast<size_t>(c)];
-      if (s.histogram.empty()) s.histogram.assign(static_cast<size_t>(bins * bins), 0);
       s.area += x - start;
       s.x0 = std::min(s.x0, start);
       s.x1 = std::max(s.x1, x - 1);
       s.y0 = std::min(s.y0, y);
       s.y1 = y;
-      const size_t first = s.pixels.size();
-      s.pixels.resize(first + static_cast<size_t>(x - start));
-      std::iota(s.pixels.begin() + static_cast<std::ptrdiff_t>(first), s.pixels.end(), y * cols + start);
-      add_run(&pts[start][0], x - start, s.point);
-      add_run(&nrm[start][0], x - start, s.normal);
-      for (int k = start; k < x; ++k) ++s.histogram[static_cast<size_t>(bin[static_cast<size_t>(k)])];
     }
+  }
+  for (ComponentSums& s : sums)
+    if (s.area >= min_size) {
+      s.pixels.reserve(static_cast<size_t>(s.area));
+      s.histogram.assign(static_cast<size_t>(bins * bins), 0);
+    }
+  std::vector<int> bin(static_cast<size_t>(cols));  // histogram bin of each pixel of a run
+  for (const Run& run : runs) {
+    ComponentSums& s = sums[static_cast<size_t>(run.component)];
+    if (s.area < min_size) continue;
+    const int n = run.x1 - run.x0;
+    const float* pts = &points.ptr<cv::Vec3f>(run.y)[run.x0][0];
+    const float* nrm = &normals.ptr<cv::Vec3f>(run.y)[run.x0][0];
+    const size_t first = s.pixels.size();
+    s.pixels.resize(first + static_cast<size_t>(n));  // within the reserved area: no reallocation
+    std::iota(s.pixels.begin() + static_cast<std::ptrdiff_t>(first), s.pixels.end(), run.y * cols + run.x0);
+    add_run(pts, n, s.point);
+    add_run(nrm, n, s.normal);
+    normal_bins(nrm, n, bins, bin.data());
+    for (int k = 0; k < n; ++k) ++s.histogram[static_cast<size_t>(bin[static_cast<size_t>(k)])];
   }
 
   // Components of at least min_size pixels become patches 1..N, in OpenCV's (raster) order.
