@@ -94,7 +94,7 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
   for (ComponentSums& s : sums)
     if (s.area >= min_size) {
       s.pixels.reserve(static_cast<size_t>(s.area));
-      s.histogram.assign(static_cast<size_t>(bins * bins), 0);
+      s.histogram.assign(static_cast<size_t>(4 * bins * bins), 0);
     }
   std::vector<int> bin(static_cast<size_t>(cols));  // histogram bin of each pixel of a run
   for (const Run& run : runs) {
@@ -109,7 +109,19 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     add_run(pts, n, s.point);
     add_run(nrm, n, s.normal);
     normal_bins(nrm, n, bins, bin.data());
-    for (int k = 0; k < n; ++k) ++s.histogram[static_cast<size_t>(bin[static_cast<size_t>(k)])];
+    // Four counters per bin, summed when the patch is made: neighbouring pixels mostly share a bin, and
+    // with one counter each increment would wait for the previous one.
+    int* const counts = s.histogram.data();
+    const int* const b = bin.data();
+    const int cells = bins * bins;
+    int k = 0;
+    for (; k + 4 <= n; k += 4) {
+      ++counts[b[k]];
+      ++counts[cells + b[k + 1]];
+      ++counts[2 * cells + b[k + 2]];
+      ++counts[3 * cells + b[k + 3]];
+    }
+    for (; k < n; ++k) ++counts[b[k]];
   }
 
   // Components of at least min_size pixels become patches 1..N, in OpenCV's (raster) order.
@@ -130,8 +142,12 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     // Mean angular deviation, taken as the angle of the mean normal's length: |mean of unit normals|
     // = mean cos(deviation) for small spreads; one acos per patch instead of one per pixel.
     p.spread_deg = static_cast<float>(std::acos(std::clamp(normal_sum.norm() / n, 0.0, 1.0)) * 180.0 / M_PI);
-    p.histogram.resize(s.histogram.size());
-    for (size_t b = 0; b < s.histogram.size(); ++b) p.histogram[b] = static_cast<float>(s.histogram[b]) * static_cast<float>(1.0 / n);
+    const size_t cells = static_cast<size_t>(params.histogram_bins * params.histogram_bins);
+    p.histogram.resize(cells);
+    for (size_t b = 0; b < cells; ++b) {
+      const int count = s.histogram[b] + s.histogram[cells + b] + s.histogram[2 * cells + b] + s.histogram[3 * cells + b];
+      p.histogram[b] = static_cast<float>(count) * static_cast<float>(1.0 / n);
+    }
     p.occupied_bins = static_cast<int>(std::count_if(p.histogram.begin(), p.histogram.end(),
         [&](float h) { return h >= params.occupied_share; }));
     p.curved = p.occupied_bins >= params.flat_max_bins;
