@@ -23,8 +23,12 @@ struct ComponentSums {
   int x0 = INT_MAX, y0 = INT_MAX, x1 = -1, y1 = -1;  // bounding box, inclusive
   double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
   std::vector<int> pixels;
-  std::vector<int> histogram;  // bins x bins counts
+  // bins x bins counts, kCounters times over: pixel k of a run counts in copy k % kCounters, summed when
+  // the patch is made. Neighbouring pixels mostly share a bin; with one counter per bin, each increment
+  // would wait for the previous one.
+  std::vector<int> histogram;
 };
+constexpr int kCounters = 4;
 
 // sum[d] += v[3 k + d] for the n interleaved 3-vectors v. Four vectors (12 floats) at a time go into
 // three sums of 4 doubles, lanes (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3): three independent chains of
@@ -94,7 +98,7 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
   for (ComponentSums& s : sums)
     if (s.area >= min_size) {
       s.pixels.reserve(static_cast<size_t>(s.area));
-      s.histogram.assign(static_cast<size_t>(4 * bins * bins), 0);
+      s.histogram.assign(static_cast<size_t>(kCounters * bins * bins), 0);
     }
   std::vector<int> bin(static_cast<size_t>(cols));  // histogram bin of each pixel of a run
   for (const Run& run : runs) {
@@ -109,19 +113,13 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     add_run(pts, n, s.point);
     add_run(nrm, n, s.normal);
     normal_bins(nrm, n, bins, bin.data());
-    // Four counters per bin, summed when the patch is made: neighbouring pixels mostly share a bin, and
-    // with one counter each increment would wait for the previous one.
     int* const counts = s.histogram.data();
-    const int* const b = bin.data();
     const int cells = bins * bins;
     int k = 0;
-    for (; k + 4 <= n; k += 4) {
-      ++counts[b[k]];
-      ++counts[cells + b[k + 1]];
-      ++counts[2 * cells + b[k + 2]];
-      ++counts[3 * cells + b[k + 3]];
-    }
-    for (; k < n; ++k) ++counts[b[k]];
+    for (; k + kCounters <= n; k += kCounters)
+#pragma GCC unroll 4
+      for (int copy = 0; copy < kCounters; ++copy) ++counts[copy * cells + bin[static_cast<size_t>(k + copy)]];
+    for (; k < n; ++k) ++counts[bin[static_cast<size_t>(k)]];
   }
 
   // Components of at least min_size pixels become patches 1..N, in OpenCV's (raster) order.
@@ -145,7 +143,8 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     const size_t cells = static_cast<size_t>(params.histogram_bins * params.histogram_bins);
     p.histogram.resize(cells);
     for (size_t b = 0; b < cells; ++b) {
-      const int count = s.histogram[b] + s.histogram[cells + b] + s.histogram[2 * cells + b] + s.histogram[3 * cells + b];
+      int count = 0;
+      for (size_t copy = 0; copy < kCounters; ++copy) count += s.histogram[copy * cells + b];
       p.histogram[b] = static_cast<float>(count) * static_cast<float>(1.0 / n);
     }
     p.occupied_bins = static_cast<int>(std::count_if(p.histogram.begin(), p.histogram.end(),
