@@ -26,17 +26,15 @@ CLUTTERSEG_ROW_KERNEL void raw_normal_row(const float* __restrict up, const floa
   for (int x = 0; x < cols; ++x) {
     const float z = mid[x], lim = jump_limit * z;
     const float zl = mid[x - s], zr = mid[x + s], zu = up[x], zd = down[x];
-    // 1 where the neighbour continues the surface, else 0 (arithmetic blends vectorise).
-    const float l = (zl > 0.f) & (std::abs(zl - z) <= lim) ? 1.f : 0.f;
-    const float r = (zr > 0.f) & (std::abs(zr - z) <= lim) ? 1.f : 0.f;
-    const float u = (zu > 0.f) & (std::abs(zu - z) <= lim) ? 1.f : 0.f;
-    const float d = (zd > 0.f) & (std::abs(zd - z) <= lim) ? 1.f : 0.f;
+    // Whether the neighbour continues the surface (a measurement, no depth jump).
+    const bool l = (zl > 0.f) & (std::abs(zl - z) <= lim), r = (zr > 0.f) & (std::abs(zr - z) <= lim);
+    const bool u = (zu > 0.f) & (std::abs(zu - z) <= lim), d = (zd > 0.f) & (std::abs(zd - z) <= lim);
     const float px = rx[x] * z, py = ry * z;
     // Horizontal tangent a - b, vertical tangent c - e; a missing neighbour is replaced by the centre.
-    const float ax = px + r * (rx[x + s] * zr - px), ay = py + r * (ry * zr - py), az = z + r * (zr - z);
-    const float bx = px + l * (rx[x - s] * zl - px), by = py + l * (ry * zl - py), bz = z + l * (zl - z);
-    const float cx = px + d * (rx[x] * zd - px), cy = py + d * (ry_down * zd - py), cz = z + d * (zd - z);
-    const float ex = px + u * (rx[x] * zu - px), ey = py + u * (ry_up * zu - py), ez = z + u * (zu - z);
+    const float ax = r ? rx[x + s] * zr : px, ay = r ? ry * zr : py, az = r ? zr : z;
+    const float bx = l ? rx[x - s] * zl : px, by = l ? ry * zl : py, bz = l ? zl : z;
+    const float cx = d ? rx[x] * zd : px, cy = d ? ry_down * zd : py, cz = d ? zd : z;
+    const float ex = u ? rx[x] * zu : px, ey = u ? ry_up * zu : py, ez = u ? zu : z;
     const float tux = ax - bx, tuy = ay - by, tuz = az - bz;
     const float tvx = cx - ex, tvy = cy - ey, tvz = cz - ez;
     // tv x tu faces the camera for any surface seen from the front (x right, y down, z forward).
