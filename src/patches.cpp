@@ -119,7 +119,7 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     for (; k + kCounters <= n; k += kCounters)
 #pragma GCC unroll 4
       for (int copy = 0; copy < kCounters; ++copy) ++counts[copy * cells + bin[static_cast<size_t>(k + copy)]];
-    for (; k < n; ++k) ++counts[bin[static_cast<size_t>(k)]];
+    for (; k < n; ++k) ++counts[(k % kCounters) * cells + bin[static_cast<size_t>(k)]];
   }
 
   // Components of at least min_size pixels become patches 1..N, in OpenCV's (raster) order.
@@ -140,7 +140,7 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     // Mean angular deviation, taken as the angle of the mean normal's length: |mean of unit normals|
     // = mean cos(deviation) for small spreads; one acos per patch instead of one per pixel.
     p.spread_deg = static_cast<float>(std::acos(std::clamp(normal_sum.norm() / n, 0.0, 1.0)) * 180.0 / M_PI);
-    const size_t cells = static_cast<size_t>(params.histogram_bins * params.histogram_bins);
+    const size_t cells = static_cast<size_t>(bins * bins);
     p.histogram.resize(cells);
     for (size_t b = 0; b < cells; ++b) {
       int count = 0;

@@ -93,8 +93,9 @@ cv::Mat median_depth(const cv::Mat& depth) {
       float* o = out.ptr<float>(y);
       mark_hole_borders(up, mid, down, cols, o, redo.data());
       for (const int x : {0, cols - 1}) {  // the first and last column: next to the border
-        redo[static_cast<size_t>(x)] = mid[x] > 0;
-        if (!(mid[x] > 0)) o[x] = 0.f;
+        const bool valid = mid[x] > 0;
+        redo[static_cast<size_t>(x)] = valid;
+        o[x] = valid ? o[x] : 0.f;
       }
       const uchar* r = redo.data();
       for (int x = first_nonzero(r, 0, cols); x < cols; x = first_nonzero(r, x + 1, cols))
