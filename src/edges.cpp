@@ -68,27 +68,33 @@ cv::Mat normal_edge_value(const NormalPlanes& n, int step) {
   // Planes make the inner loops plain float arrays. A missing normal is (0,0,0), so it contributes 0
   // to its neighbours' mean and gets 0 itself, without a branch.
   const int rows = n[0].rows, cols = n[0].cols;
-  cv::Mat value(n[0].size(), CV_32F, cv::Scalar(0));
+  cv::Mat value(n[0].size(), CV_32F);
   parallel_for_rows(rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y) {
       float* v = value.ptr<float>(y);
-      const bool inner_row = y >= step && y + step < rows;
+      // row[r][c]: plane c of the image row (r - 1) * step away, null outside the image.
+      const float* row[3][3];
+      for (int r = 0; r < 3; ++r) {
+        const int yy = y + (r - 1) * step;
+        for (int c = 0; c < 3; ++c) row[r][c] = yy >= 0 && yy < rows ? n[c].ptr<float>(yy) : nullptr;
+      }
+      const bool inner_row = row[0][0] && row[2][0];
       const int x0 = inner_row ? step : cols, x1 = inner_row ? cols - step : cols;
       if (inner_row)
-        edge_value_row(n[0].ptr<float>(y - step), n[1].ptr<float>(y - step), n[2].ptr<float>(y - step),
-                       n[0].ptr<float>(y), n[1].ptr<float>(y), n[2].ptr<float>(y), n[0].ptr<float>(y + step),
-                       n[1].ptr<float>(y + step), n[2].ptr<float>(y + step), step, x0, x1, v);
+        edge_value_row(row[0][0], row[0][1], row[0][2], row[1][0], row[1][1], row[1][2], row[2][0], row[2][1],
+                       row[2][2], step, x0, x1, v);
       // Image border: the mean over the neighbours that lie inside the image.
       for (int x = 0; x < cols; ++x) {
         if (x == x0) x = x1;
         if (x >= cols) break;
         float sum = 0;
         int count = 0;
-        const float a = n[0].ptr<float>(y)[x], b = n[1].ptr<float>(y)[x], c = n[2].ptr<float>(y)[x];
+        const float a = row[1][0][x], b = row[1][1][x], c = row[1][2][x];
         for (const auto& d : kDirs) {
-          const int xx = x + d[0] * step, yy = y + d[1] * step;
-          if (xx < 0 || yy < 0 || xx >= cols || yy >= rows) continue;
-          sum += std::abs(a * n[0].ptr<float>(yy)[xx] + b * n[1].ptr<float>(yy)[xx] + c * n[2].ptr<float>(yy)[xx]);
+          const float* const* q = row[d[1] + 1];
+          const int xx = x + d[0] * step;
+          if (!q[0] || xx < 0 || xx >= cols) continue;
+          sum += std::abs(a * q[0][xx] + b * q[1][xx] + c * q[2][xx]);
           ++count;
         }
         v[x] = sum / static_cast<float>(count);
