@@ -61,12 +61,6 @@ CLUTTERSEG_ROW_KERNEL void normal_bins(const float* __restrict normals, int n, i
   }
 }
 
-// out[i] = new_id[in[i]] (a vectorised gather).
-CLUTTERSEG_ROW_KERNEL void relabel(const int* __restrict in, const int* __restrict new_id, int total,
-                                   int* __restrict out) {
-  for (int i = 0; i < total; ++i) out[i] = new_id[in[i]];
-}
-
 }  // namespace
 
 Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::Mat& normals,
@@ -78,14 +72,15 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
   const int bins = params.histogram_bins, cols = edges.cols;
   std::vector<ComponentSums> sums(static_cast<size_t>(count));
   // First the runs, with each component's area and box; then the statistics, only for the components
-  // that are large enough to become patches (most components are specks along the edges).
+  // that are large enough to become patches (most components are specks along the edges). A run of
+  // non-edge pixels along a row lies in one component: the runs are read from the edge mask (a byte
+  // per pixel), the component at the run's first pixel.
   std::vector<Run> runs;
   for (int y = 0; y < edges.rows; ++y) {
-    const int* comp = components.ptr<int>(y);
-    for (int x = 0; x < cols;) {
-      const int c = comp[x], start = x;
-      x = run_end(comp, x, cols);
-      if (c == 0) continue;
+    const uchar* edge = edges.ptr<uchar>(y);
+    for (int x = first_zero(edge, 0, cols); x < cols; x = first_zero(edge, x, cols)) {
+      const int start = x, c = components.ptr<int>(y)[x];
+      x = first_nonzero(edge, x, cols);
       runs.push_back({c, y, start, x});
       ComponentSums& s = sums[static_cast<size_t>(c)];
       s.area += x - start;
@@ -153,11 +148,17 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::M
     p.pixels = std::move(s.pixels);
     out.patches.push_back(std::move(p));
   }
+  // The patch image, run by run (edge pixels and small components 0).
   out.labels = cv::Mat(edges.size(), CV_32S);
-  const int total = static_cast<int>(edges.total());
-  const int* comp = components.ptr<int>();
-  int* lab = out.labels.ptr<int>();
-  relabel(comp, new_id.data(), total, lab);
+  int* const labels = out.labels.ptr<int>();
+  size_t done = 0;  // pixels written, in raster order
+  for (const Run& run : runs) {
+    const size_t begin = static_cast<size_t>(run.y) * static_cast<size_t>(cols), from = begin + static_cast<size_t>(run.x0);
+    std::fill(labels + done, labels + from, 0);
+    done = begin + static_cast<size_t>(run.x1);
+    std::fill(labels + from, labels + done, new_id[static_cast<size_t>(run.component)]);
+  }
+  std::fill(labels + done, labels + edges.total(), 0);
   return out;
 }
 

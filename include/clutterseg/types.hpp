@@ -60,6 +60,19 @@ inline int first_nonzero(const std::uint8_t* bytes, int from, int end) {
   return from;
 }
 
+// First index in [from, end) where bytes[i] == 0, or end; eight bytes per step through set ones.
+inline int first_zero(const std::uint8_t* bytes, int from, int end) {
+  if (from < end && !bytes[from]) return from;  // inside a run of zeros
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull, kHighs = 0x8080808080808080ull;
+  for (; from + 8 <= end; from += 8) {
+    std::uint64_t eight;
+    std::memcpy(&eight, bytes + from, sizeof eight);
+    if ((eight - kOnes) & ~eight & kHighs) break;  // some byte is 0 (exact, no false positive)
+  }
+  while (from < end && bytes[from]) ++from;
+  return from;
+}
+
 // Checks intrinsics against an image; throws Error("<what>: ...") when they do not fit.
 void check_camera(const Camera& camera, int width, int height, const std::string& what);
 
