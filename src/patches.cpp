@@ -34,7 +34,7 @@ constexpr int kCounters = 4;
 // three sums of 4 doubles, lanes (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3): three independent chains of
 // adds instead of one, whose latency bound the loop. The order differs from a plain loop only in the
 // last bits of the double sums, far below the float results.
-CLUTTERSEG_ROW_KERNEL void add_run(const float* __restrict v, int n, double* __restrict sum) {
+CLUTTERSEG_AVX2_KERNEL void add_run(const float* __restrict v, int n, double* __restrict sum) {
   using Floats = float __attribute__((vector_size(16)));
   using Doubles = double __attribute__((vector_size(32)));
   Doubles a = {0, 0, 0, 0}, b = a, c = a;
@@ -54,7 +54,7 @@ CLUTTERSEG_ROW_KERNEL void add_run(const float* __restrict v, int n, double* __r
 }
 
 // normal_bin of each of n interleaved normals, in one vectorised pass.
-CLUTTERSEG_ROW_KERNEL void normal_bins(const float* __restrict normals, int n, int bins, int* __restrict out) {
+CLUTTERSEG_AVX2_KERNEL void normal_bins(const float* __restrict normals, int n, int bins, int* __restrict out) {
   for (int k = 0; k < n; ++k) {
     const cv::Vec3f normal(normals[3 * k], normals[3 * k + 1], normals[3 * k + 2]);
     out[k] = normal_bin(normal, bins);

@@ -62,7 +62,7 @@ float median_of_valid_neighbours(const cv::Mat& depth, int x, int y) {
 
 // One row of the median's fix-up, columns [1, cols - 1): out = 0 where mid has no measurement (OpenCV's
 // median fills holes), and redo = 1 where mid has one but a 3x3 neighbour in up, mid or down has not.
-CLUTTERSEG_ROW_KERNEL void mark_hole_borders(const float* __restrict up, const float* __restrict mid,
+CLUTTERSEG_AVX2_KERNEL void mark_hole_borders(const float* __restrict up, const float* __restrict mid,
                                              const float* __restrict down, int cols, float* __restrict out,
                                              uchar* __restrict redo) {
   for (int x = 1; x + 1 < cols; ++x) {
