@@ -365,7 +365,7 @@ void for_each_run(const cv::Mat& object_labels, int num_objects, Visit visit) {
 // Coordinates come as planes (x, y, z), so that the loop vectorises (float lanes, OpenMP simd); relative
 // to a point of the object the values are centimetres, so float sums of a run (at most one image row)
 // lose nothing that matters.
-CLUTTERSEG_ROW_KERNEL void centred_sums(const float* __restrict px, const float* __restrict py,
+CLUTTERSEG_AVX2_KERNEL void centred_sums(const float* __restrict px, const float* __restrict py,
                                         const float* __restrict pz, int count, const float* __restrict origin,
                                         double* __restrict total) {
   float n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;

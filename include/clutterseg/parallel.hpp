@@ -7,9 +7,10 @@
 // Per-pixel row kernels are compiled for AVX-512 (x86-64-v4), AVX2 and plain x86-64 and picked when the
 // library loads, so one build is fast on current CPUs and runs on any. No -march flag: Eigen's struct
 // alignment (and so the ABI with PCL and other users) stays the default. No FMA contraction
-// (-ffp-contract=off): every version gives identical bits. Kernels over short runs, and the hole-border
-// mask, measured slower with 16-wide vectors (the scalar tail is longer, byte masks need packing):
-// those are CLUTTERSEG_AVX2_KERNEL, without the AVX-512 version (docs/BENCHMARKS.md).
+// (-ffp-contract=off), so the versions give identical bits. CLUTTERSEG_AVX2_KERNEL leaves out the
+// AVX-512 version: for kernels over short runs and the hole-border mask, which measured slower 16 wide
+// (docs/BENCHMARKS.md), and for float sums vectorised with `omp simd reduction`, whose last bits depend
+// on the vector width (AVX-512 machines then give the bits AVX2 machines give).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define CLUTTERSEG_ROW_KERNEL __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 #define CLUTTERSEG_AVX2_KERNEL __attribute__((target_clones("avx2", "default")))
