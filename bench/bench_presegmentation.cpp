@@ -107,7 +107,7 @@ const std::vector<Stages>& stages(int subsample) {
                                 relative_jump_limit(kParams.edges, step, in.camera), &s.normal_planes);
     s.edges = edge_mask(normal_edge_value(s.normal_planes, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
                         relative_jump_limit(kParams.edges, 1, in.camera));
-    s.patches = extract_patches(s.edges, s.points, s.normals, kParams.patches, px.area(kParams.patches.min_size_px));
+    s.patches = extract_patches(s.edges, s.depth, in.camera, s.normals, kParams.patches, px.area(kParams.patches.min_size_px));
     out.push_back(std::move(s));
   }
   return cache[subsample] = out;
@@ -130,7 +130,7 @@ void Edges(benchmark::State& st) {
 void SurfacePatches(benchmark::State& st) {
   per_stage_frame(st, [](const Stages& s, const Camera& c) {
     const PixelScale px(c.fx, c.fy);
-    return extract_patches(s.edges, s.points, s.normals, kParams.patches, px.area(kParams.patches.min_size_px)).patches.size();
+    return extract_patches(s.edges, s.depth, c, s.normals, kParams.patches, px.area(kParams.patches.min_size_px)).patches.size();
   });
 }
 
@@ -156,18 +156,18 @@ void OpenCVCalls(benchmark::State& st) {
   });
 }
 
-// Everything from raw metres to patches: a) median, temporal, points, normals; b) edges; c) patches.
+// Everything from raw metres to patches: a) median, temporal, normals; b) edges; c) patches. (The point
+// cloud is built after the patches, for stages d) to j); the patches need only the depth.)
 size_t presegment(TemporalSmoother& t, const cv::Mat& raw, const Camera& c) {
   const PixelScale px(c.fx, c.fy);
   const int step = px.length(kParams.normals.step_px), edge_step = px.length(kParams.edges.step_px);
   const cv::Mat depth = t.push(median_depth(raw), kParams.smoothing);
-  const cv::Mat points = depth_to_points(depth, c);
   NormalPlanes planes;
   const cv::Mat normals = compute_normals(depth, c, step, px.odd(kParams.normals.smooth_ksize),
                                           relative_jump_limit(kParams.edges, step, c), &planes);
   const cv::Mat edges = edge_mask(normal_edge_value(planes, edge_step), depth, kParams.edges.theta,
                                   relative_jump_limit(kParams.edges, 1, c));
-  return extract_patches(edges, points, normals, kParams.patches, px.area(kParams.patches.min_size_px)).patches.size();
+  return extract_patches(edges, depth, c, normals, kParams.patches, px.area(kParams.patches.min_size_px)).patches.size();
 }
 
 // Seconds per pixel (shown with an SI prefix: 14n = 14 ns), beside the time per frame.

@@ -65,15 +65,23 @@ CLUTTERSEG_ROW_KERNEL void normalize_row(const float* __restrict z, int cols, fl
 
 }  // namespace
 
+std::vector<float> ray_x(const Camera& camera, int cols) {
+  const float ifx = static_cast<float>(1.0 / camera.fx), cx = static_cast<float>(camera.cx);
+  std::vector<float> rays(static_cast<size_t>(cols));
+  for (int u = 0; u < cols; ++u) rays[static_cast<size_t>(u)] = (static_cast<float>(u) - cx) * ifx;
+  return rays;
+}
+
+float ray_y(const Camera& camera, int v) {
+  return (static_cast<float>(v) - static_cast<float>(camera.cy)) * static_cast<float>(1.0 / camera.fy);
+}
+
 cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera) {
   cv::Mat points(depth.size(), CV_32FC3);
-  const float ifx = static_cast<float>(1.0 / camera.fx), ify = static_cast<float>(1.0 / camera.fy);
-  const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
-  std::vector<float> ray_x(static_cast<size_t>(depth.cols));
-  for (int x = 0; x < depth.cols; ++x) ray_x[static_cast<size_t>(x)] = (static_cast<float>(x) - cx) * ifx;
+  const std::vector<float> rays = ray_x(camera, depth.cols);
   parallel_for_rows(depth.rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
-      point_row(depth.ptr<float>(y), ray_x.data(), (static_cast<float>(y) - cy) * ify, depth.cols, points.ptr<float>(y));
+      point_row(depth.ptr<float>(y), rays.data(), ray_y(camera, y), depth.cols, points.ptr<float>(y));
   });
   return points;
 }
@@ -89,15 +97,15 @@ cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, in
   // Zero padding: a neighbour outside the image is "no measurement", like a hole.
   cv::Mat padded;
   cv::copyMakeBorder(depth, padded, s, s, s, s, cv::BORDER_CONSTANT, cv::Scalar(0));
-  std::vector<float> ray_x(static_cast<size_t>(cols + 2 * s));  // (u - cx) / fx per padded column
-  for (int u = 0; u < cols + 2 * s; ++u) ray_x[static_cast<size_t>(u)] = static_cast<float>((u - s - camera.cx) / camera.fx);
-  const auto ray_y = [&](int v) { return static_cast<float>((v - camera.cy) / camera.fy); };
+  std::vector<float> column_ray(static_cast<size_t>(cols + 2 * s));  // (u - cx) / fx per padded column
+  for (int u = 0; u < cols + 2 * s; ++u) column_ray[static_cast<size_t>(u)] = static_cast<float>((u - s - camera.cx) / camera.fx);
+  const auto row_ray = [&](int v) { return static_cast<float>((v - camera.cy) / camera.fy); };
 
   NormalPlanes planes = {cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F)};
   parallel_for_rows(rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
       raw_normal_row(padded.ptr<float>(y) + s, padded.ptr<float>(y + s) + s, padded.ptr<float>(y + 2 * s) + s,
-                     ray_x.data() + s, ray_y(y), ray_y(y - s), ray_y(y + s), cols, s, jump_limit,
+                     column_ray.data() + s, row_ray(y), row_ray(y - s), row_ray(y + s), cols, s, jump_limit,
                      planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
   });
   if (ksize > 1)

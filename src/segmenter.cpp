@@ -72,19 +72,19 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   if (p.smoothing.temporal) depth = temporal_.push(depth, p.smoothing);          // a) temporal smoothing
   watch.mark("temporal_smoothing");
   r.depth = depth;
-  r.points = depth_to_points(depth, camera);                                     // point cloud
-  watch.mark("pointcloud");
   NormalPlanes normals;
   r.normals = compute_normals(depth, camera, step, px.odd(p.normals.smooth_ksize), jump, &normals);  // a) normals
   watch.mark("normals");
   r.edge_value = normal_edge_value(normals, edge_step);                          // b) normal edges
   r.edges = edge_mask(r.edge_value, r.depth, p.edges.theta, pixel_jump);
   watch.mark("edges");
-  Patches patches = extract_patches(r.edges, r.points, r.normals, p.patches,     // c) surface patches
+  Patches patches = extract_patches(r.edges, r.depth, camera, r.normals, p.patches,  // c) surface patches
                                     px.area(p.patches.min_size_px));
   r.core_patch_labels = patches.labels;
   r.patches = std::move(patches.patches);
   watch.mark("patches");
+  r.points = depth_to_points(depth, camera);                                     // point cloud, for d) to j)
+  watch.mark("pointcloud");
   const int num_patches = static_cast<int>(r.patches.size());
   const Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency
                                                    px.length(p.adjacency.radius_px), p.adjacency.d_max);

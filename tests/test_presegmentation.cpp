@@ -104,8 +104,8 @@ TEST(Patches, SmallComponentsAreDropped) {
   edges.row(20).setTo(255);
   edges(cv::Rect(0, 0, 5, 5)).setTo(255);
   edges.at<uchar>(2, 2) = 0;  // a 1-pixel island
-  cv::Mat pts(40, 40, CV_32FC3, cv::Scalar(0, 0, 1)), nrm(40, 40, CV_32FC3, cv::Scalar(0, 0, -1));
-  const Patches p = extract_patches(edges, pts, nrm, Params::Patches{}, 10);
+  cv::Mat depth(40, 40, CV_32F, cv::Scalar(1)), nrm(40, 40, CV_32FC3, cv::Scalar(0, 0, -1));
+  const Patches p = extract_patches(edges, depth, synth::default_camera(40, 40), nrm, Params::Patches{}, 10);
   EXPECT_EQ(p.patches.size(), 2u);
   EXPECT_EQ(p.labels.at<int>(2, 2), 0);
 }

@@ -12,8 +12,9 @@ struct Patches {
 };
 
 // 4-connected components of the non-edge pixels; components smaller than min_size (already scaled
-// to the resolution) are dropped. Statistics per patch from points and normals.
-Patches extract_patches(const cv::Mat& edges, const cv::Mat& points, const cv::Mat& normals,
+// to the resolution) are dropped. Statistics per patch from the depth (CV_32F metres; the centroid of
+// the points depth_to_points gives) and the normals (CV_32FC3).
+Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera, const cv::Mat& normals,
                         const Params::Patches& params, int min_size);
 
 // The bin of a unit normal in the (x, y) histogram of normals: bins x bins cells over [-1, 1]^2.
