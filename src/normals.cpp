@@ -94,19 +94,23 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
 cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit,
                         NormalPlanes* planes_out) {
   const int rows = depth.rows, cols = depth.cols, s = step;
-  // Zero padding: a neighbour outside the image is "no measurement", like a hole.
-  cv::Mat padded;
-  cv::copyMakeBorder(depth, padded, s, s, s, s, cv::BORDER_CONSTANT, cv::Scalar(0));
   std::vector<float> column_ray(static_cast<size_t>(cols + 2 * s));  // (u - cx) / fx per padded column
   for (int u = 0; u < cols + 2 * s; ++u) column_ray[static_cast<size_t>(u)] = static_cast<float>((u - s - camera.cx) / camera.fx);
   const auto row_ray = [&](int v) { return static_cast<float>((v - camera.cy) / camera.fy); };
+  // A neighbour outside the image is "no measurement", like a hole: rows outside read a row of zeros,
+  // and each row is copied between s zeros on either side (a small buffer, not a padded image).
+  const std::vector<float> zeros(static_cast<size_t>(cols), 0.f);
 
   NormalPlanes planes = {cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F), cv::Mat(depth.size(), CV_32F)};
   parallel_for_rows(rows, [&](int begin, int end) {
-    for (int y = begin; y < end; ++y)
-      raw_normal_row(padded.ptr<float>(y) + s, padded.ptr<float>(y + s) + s, padded.ptr<float>(y + 2 * s) + s,
-                     column_ray.data() + s, row_ray(y), row_ray(y - s), row_ray(y + s), cols, s, jump_limit,
-                     planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
+    std::vector<float> mid(static_cast<size_t>(cols + 2 * s), 0.f);
+    for (int y = begin; y < end; ++y) {
+      std::copy_n(depth.ptr<float>(y), cols, mid.begin() + s);
+      const float* up = y - s >= 0 ? depth.ptr<float>(y - s) : zeros.data();
+      const float* down = y + s < rows ? depth.ptr<float>(y + s) : zeros.data();
+      raw_normal_row(up, mid.data() + s, down, column_ray.data() + s, row_ray(y), row_ray(y - s), row_ray(y + s), cols,
+                     s, jump_limit, planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
+    }
   });
   if (ksize > 1)
     for (auto& p : planes) cv::GaussianBlur(p, p, cv::Size(ksize, ksize), 0, 0, cv::BORDER_REPLICATE);
