@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <utility>
@@ -29,12 +30,29 @@ cv::Mat depth_to_metres(const cv::Mat& depth, const Camera& camera) {
 
 namespace {
 
+// Floyd's sorting network for nine values (25 compare-exchanges), on floats or on 8 lanes of floats
+// (the compare-exchange is std::min and std::max, written so that it also applies lane by lane).
+using Float8 = float __attribute__((vector_size(32)));
+using Int8 = int __attribute__((vector_size(32)));
+template <typename V>
+inline void sort_nine(V (&v)[9]) {
+  static constexpr int kNetwork[25][2] = {{0, 1}, {3, 4}, {6, 7}, {1, 2}, {4, 5}, {7, 8}, {0, 1}, {3, 4}, {6, 7},
+                                          {0, 3}, {3, 6}, {0, 3}, {1, 4}, {4, 7}, {1, 4}, {2, 5}, {5, 8}, {2, 5},
+                                          {1, 3}, {5, 7}, {2, 6}, {4, 6}, {2, 4}, {2, 3}, {5, 6}};
+#pragma GCC unroll 25  // unrolled, v stays in registers
+  for (const auto& [a, b] : kNetwork) {
+    const V lo = v[b] < v[a] ? v[b] : v[a], hi = v[a] < v[b] ? v[b] : v[a];
+    v[a] = lo;
+    v[b] = hi;
+  }
+}
+constexpr float kMissing = std::numeric_limits<float>::infinity();
+
 // Median of the valid (> 0) values among the 3x3 neighbours of (x, y), for a pixel next to a hole or
-// the image border. The nine values go through a sorting network (Floyd's, 25 compare-exchanges), a
-// missing one as +inf so that it sorts last; the median of the n valid values is then element n / 2.
-// No branch depends on the data: around holes, which neighbours are valid is not predictable.
+// the image border. The nine values are sorted, a missing one as +inf so that it sorts last; the
+// median of the n valid values is then element n / 2. No branch depends on the data: around holes,
+// which neighbours are valid is not predictable.
 float median_of_valid_neighbours(const cv::Mat& depth, int x, int y) {
-  constexpr float kMissing = std::numeric_limits<float>::infinity();
   float v[9];
   int n = 0;
   for (int dy = -1, k = 0; dy <= 1; ++dy) {
@@ -48,16 +66,33 @@ float median_of_valid_neighbours(const cv::Mat& depth, int x, int y) {
       n += valid;
     }
   }
-  static constexpr int kNetwork[25][2] = {{0, 1}, {3, 4}, {6, 7}, {1, 2}, {4, 5}, {7, 8}, {0, 1}, {3, 4}, {6, 7},
-                                          {0, 3}, {3, 6}, {0, 3}, {1, 4}, {4, 7}, {1, 4}, {2, 5}, {5, 8}, {2, 5},
-                                          {1, 3}, {5, 7}, {2, 6}, {4, 6}, {2, 4}, {2, 3}, {5, 6}};
-#pragma GCC unroll 25  // unrolled, v stays in registers
-  for (const auto& [a, b] : kNetwork) {
-    const float lo = std::min(v[a], v[b]), hi = std::max(v[a], v[b]);
-    v[a] = lo;
-    v[b] = hi;
-  }
+  sort_nine(v);
   return v[n / 2];  // n >= 1: the pixel itself is valid
+}
+
+// median_of_valid_neighbours of the 8 pixels x .. x + 7 of row `mid`, in the lanes of 8-float vectors:
+// the neighbours are 8 consecutive floats of each row. Away from the left and right image border
+// (1 <= x, x + 9 <= cols); `up` and `down` are rows of zeros beyond the top and bottom. The same
+// network on the same values: the same bits as one pixel at a time.
+CLUTTERSEG_AVX2_KERNEL void medians_of_valid_neighbours(const float* __restrict up, const float* __restrict mid,
+                                                        const float* __restrict down, int x, float* __restrict out) {
+  const float* rows[3] = {up, mid, down};
+  const Float8 zero = {}, missing = zero + kMissing;
+  Float8 v[9];
+  Int8 n = {};
+  for (int dy = 0, k = 0; dy < 3; ++dy)
+    for (int dx = -1; dx <= 1; ++dx, ++k) {
+      Float8 z;
+      std::memcpy(&z, rows[dy] + x + dx, sizeof z);
+      const Int8 valid = z > zero;  // -1 in valid lanes
+      v[k] = valid ? z : missing;
+      n -= valid;
+    }
+  sort_nine(v);
+  const Int8 half = n >> 1;
+  Float8 median = v[0];
+  for (int k = 1; k < 9; ++k) median = half == k ? v[k] : median;
+  std::memcpy(out, &median, sizeof median);
 }
 
 // One row of the median's fix-up, columns [1, cols - 1): out = 0 where mid has no measurement (OpenCV's
@@ -97,9 +132,20 @@ cv::Mat median_depth(const cv::Mat& depth) {
         redo[static_cast<size_t>(x)] = valid;
         o[x] = valid ? o[x] : 0.f;
       }
+      // Eight pixels at a time from the first one to redo (the pixels to redo come in clusters
+      // around holes), one at a time at the left and right border.
       const uchar* r = redo.data();
-      for (int x = first_nonzero(r, 0, cols); x < cols; x = first_nonzero(r, x + 1, cols))
-        o[x] = median_of_valid_neighbours(depth, x, y);
+      for (int x = first_nonzero(r, 0, cols); x < cols;) {
+        if (x >= 1 && x + 9 <= cols) {
+          float medians[8];
+          medians_of_valid_neighbours(up, mid, down, x, medians);
+          for (int k = 0; k < 8; ++k) o[x + k] = r[x + k] ? medians[k] : o[x + k];
+          x = first_nonzero(r, x + 8, cols);
+        } else {
+          o[x] = median_of_valid_neighbours(depth, x, y);
+          x = first_nonzero(r, x + 1, cols);
+        }
+      }
     }
   });
   return out;
