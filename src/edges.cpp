@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "clutterseg/parallel.hpp"
 
@@ -12,13 +13,15 @@ namespace {
 
 constexpr int kDirs[8][2] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
 
-// One row of the edge value away from the image border, columns [x0, x1): the mean over the 8
-// neighbours `s` pixels away of |n . n_q|. Normals come as planes (x, y, z) of the rows y - s, y, y + s.
+// One row of the edge value away from the left and right image border, columns [x0, x1): `scale`
+// times the sum over the 8 neighbours `s` pixels away of |n . n_q| (scale 1/8: their mean). Normals
+// come as planes (x, y, z) of the rows y - s, y, y + s.
 CLUTTERSEG_ROW_KERNEL void edge_value_row(const float* __restrict ux, const float* __restrict uy,
                                           const float* __restrict uz, const float* __restrict mx,
                                           const float* __restrict my, const float* __restrict mz,
                                           const float* __restrict dx, const float* __restrict dy,
-                                          const float* __restrict dz, int s, int x0, int x1, float* __restrict v) {
+                                          const float* __restrict dz, int s, int x0, int x1, float scale,
+                                          float* __restrict v) {
   for (int x = x0; x < x1; ++x) {
     const float a = mx[x], b = my[x], c = mz[x];
     auto cosine = [&](const float* qx, const float* qy, const float* qz, int q) {
@@ -34,7 +37,7 @@ CLUTTERSEG_ROW_KERNEL void edge_value_row(const float* __restrict ux, const floa
     sum += cosine(dx, dy, dz, x - s);
     sum += cosine(dx, dy, dz, x);
     sum += cosine(dx, dy, dz, x + s);
-    v[x] = sum * 0.125f;
+    v[x] = sum * scale;
   }
 }
 
@@ -69,21 +72,27 @@ cv::Mat normal_edge_value(const NormalPlanes& n, int step) {
   // to its neighbours' mean and gets 0 itself, without a branch.
   const int rows = n[0].rows, cols = n[0].cols;
   cv::Mat value(n[0].size(), CV_32F);
+  const std::vector<float> zeros(static_cast<size_t>(cols), 0.f);  // a row outside the image: no normals
   parallel_for_rows(rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y) {
       float* v = value.ptr<float>(y);
-      // row[r][c]: plane c of the image row (r - 1) * step away, null outside the image.
+      // row[r][c]: plane c of the image row (r - 1) * step away, zeros outside the image.
       const float* row[3][3];
+      int inside = 8;  // neighbours inside the image, away from the left and right border
       for (int r = 0; r < 3; ++r) {
         const int yy = y + (r - 1) * step;
-        for (int c = 0; c < 3; ++c) row[r][c] = yy >= 0 && yy < rows ? n[c].ptr<float>(yy) : nullptr;
+        const bool in_image = yy >= 0 && yy < rows;
+        inside -= in_image ? 0 : 3;
+        for (int c = 0; c < 3; ++c) row[r][c] = in_image ? n[c].ptr<float>(yy) : zeros.data();
       }
-      const bool inner_row = row[0][0] && row[2][0];
-      const int x0 = inner_row ? step : cols, x1 = inner_row ? cols - step : cols;
-      if (inner_row)
-        edge_value_row(row[0][0], row[0][1], row[0][2], row[1][0], row[1][1], row[1][2], row[2][0], row[2][1],
-                       row[2][2], step, x0, x1, v);
-      // Image border: the mean over the neighbours that lie inside the image.
+      // Away from the left and right border: a row outside adds zeros, so the sum is that over the
+      // neighbours inside, in the same order; the mean divides by their number.
+      const int x0 = std::min(step, cols), x1 = std::max(cols - step, x0);
+      edge_value_row(row[0][0], row[0][1], row[0][2], row[1][0], row[1][1], row[1][2], row[2][0], row[2][1],
+                     row[2][2], step, x0, x1, inside == 8 ? 0.125f : 1.f, v);
+      if (inside < 8)
+        for (int x = x0; x < x1; ++x) v[x] /= static_cast<float>(inside);
+      // The left and right border: the mean over the neighbours that lie inside the image.
       for (int x = 0; x < cols; ++x) {
         if (x == x0) x = x1;
         if (x >= cols) break;
@@ -92,8 +101,8 @@ cv::Mat normal_edge_value(const NormalPlanes& n, int step) {
         const float a = row[1][0][x], b = row[1][1][x], c = row[1][2][x];
         for (const auto& d : kDirs) {
           const float* const* q = row[d[1] + 1];
-          const int xx = x + d[0] * step;
-          if (!q[0] || xx < 0 || xx >= cols) continue;
+          const int xx = x + d[0] * step, yy = y + d[1] * step;
+          if (xx < 0 || xx >= cols || yy < 0 || yy >= rows) continue;
           sum += std::abs(a * q[0][xx] + b * q[1][xx] + c * q[2][xx]);
           ++count;
         }

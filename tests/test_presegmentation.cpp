@@ -49,6 +49,44 @@ TEST(Median, IsTheMedianOfTheValidNeighboursEverywhere) {
     }
 }
 
+TEST(EdgeValue, IsTheMeanOverTheNeighboursInsideTheImageEverywhere) {
+  // Random unit normals, some missing: every pixel, the top and bottom rows (summed by the row kernel
+  // with rows of zeros) and the left and right columns (one at a time) included, against a plain loop.
+  constexpr int kStep = 2;
+  for (const cv::Size size : {cv::Size(29, 23), cv::Size(7, 4)}) {
+    NormalPlanes n;
+    cv::RNG rng(9);
+    for (auto& plane : n) {
+      plane.create(size, CV_32F);
+      rng.fill(plane, cv::RNG::UNIFORM, -1.0, 1.0);
+    }
+    cv::Mat norm;
+    cv::magnitude(n[0].mul(n[0]) + n[1].mul(n[1]), n[2], norm);
+    cv::Mat missing(size, CV_32F);
+    rng.fill(missing, cv::RNG::UNIFORM, 0.0, 1.0);
+    for (auto& plane : n) {
+      plane /= norm;
+      plane.setTo(0, missing < 0.1);
+    }
+    const cv::Mat value = normal_edge_value(n, kStep);
+    for (int y = 0; y < size.height; ++y)
+      for (int x = 0; x < size.width; ++x) {
+        double sum = 0;
+        int count = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx * kStep, yy = y + dy * kStep;
+            if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= size.width || yy >= size.height) continue;
+            double dot = 0;
+            for (const auto& plane : n) dot += plane.at<float>(y, x) * plane.at<float>(yy, xx);
+            sum += std::abs(dot);
+            ++count;
+          }
+        ASSERT_NEAR(value.at<float>(y, x), sum / count, 1e-5) << size << " at (" << x << ", " << y << ")";
+      }
+  }
+}
+
 TEST(Temporal, AveragesStaticNoiseAndKeepsMotion) {
   Params::Smoothing p;
   TemporalSmoother t;
