@@ -72,10 +72,6 @@ std::vector<float> ray_x(const Camera& camera, int cols) {
   return rays;
 }
 
-float ray_y(const Camera& camera, int v) {
-  return (static_cast<float>(v) - static_cast<float>(camera.cy)) * static_cast<float>(1.0 / camera.fy);
-}
-
 cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera) {
   cv::Mat points(depth.size(), CV_32FC3);
   const std::vector<float> rays = ray_x(camera, depth.cols);

@@ -12,7 +12,9 @@ namespace clutterseg {
 // The point of pixel (u, v) is (ray_x[u] * z, ray_y(v) * z, z), products in float, with the rays below.
 cv::Mat depth_to_points(const cv::Mat& depth, const Camera& camera);
 std::vector<float> ray_x(const Camera& camera, int cols);  // (u - cx) / fx for u = 0 .. cols - 1
-float ray_y(const Camera& camera, int v);                  // (v - cy) / fy
+inline float ray_y(const Camera& camera, int v) {           // (v - cy) / fy
+  return (static_cast<float>(v) - static_cast<float>(camera.cy)) * static_cast<float>(1.0 / camera.fy);
+}
 
 // Largest |z(q) - z(p)| / z(p) between pixels `step` apart that is not a depth discontinuity.
 float relative_jump_limit(const Params::Edges& params, int step, const Camera& camera);
