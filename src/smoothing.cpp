@@ -153,50 +153,87 @@ cv::Mat median_depth(const cv::Mat& depth) {
 
 namespace {
 
-// sum += v and count += 1 over N frames (rows `v`, oldest first), where v is a measurement within
-// band_k * z^2 of the centre z. The N frames are summed in registers in that order, so the bits do
-// not depend on how the window is cut into chunks of N.
+// s += v and c += 1 for each of the N values v (oldest first) that is a measurement in [lo, hi].
+template <int N>
+inline void add_within_band(const float* const* frame, int x, float lo, float hi, float& s, float& c) {
+  for (int i = 0; i < N; ++i) {
+    const float v = frame[i][x];
+    const bool take = (v >= lo) & (v <= hi);
+    s += take ? v : 0.f;
+    c += take ? 1.f : 0.f;
+  }
+}
+
+// The band [lo, hi] = centre +- band_k * centre^2; lo > 0, so that no missing measurement (0) falls in it.
+inline void band(float z, float band_k, float& lo, float& hi) {
+  const float limit = band_k * z * z;
+  lo = std::max(z - limit, std::numeric_limits<float>::denorm_min());
+  hi = z + limit;
+}
+
+// mean = the mean of the N frames' values (rows `v`, oldest first) within the band around the
+// centre, where the newest frame has a measurement, else 0: one pass, sums in registers.
+template <int N>
+CLUTTERSEG_ROW_KERNEL void mean_within_band(const float* const* v, const float* __restrict centre,
+                                            const float* __restrict newest, int cols, float band_k,
+                                            float* __restrict mean) {
+  const float* frame[N];
+  for (int i = 0; i < N; ++i) frame[i] = v[i];
+  for (int x = 0; x < cols; ++x) {
+    float lo, hi, s = 0, c = 0;
+    band(centre[x], band_k, lo, hi);
+    add_within_band<N>(frame, x, lo, hi, s, c);
+    mean[x] = newest[x] > 0 ? s / std::max(c, 1.f) : 0.f;
+  }
+}
+
+// The same as sums and counts, for windows longer than one kernel takes: sum += v and count += 1 over
+// N frames. The frames are added in the same order, so the bits do not depend on how the window is
+// cut into chunks.
 template <int N>
 CLUTTERSEG_ROW_KERNEL void accumulate_within_band(const float* const* v, const float* __restrict centre, int cols,
                                                   float band_k, float* __restrict sum, float* __restrict count) {
   const float* frame[N];
   for (int i = 0; i < N; ++i) frame[i] = v[i];
   for (int x = 0; x < cols; ++x) {
-    const float z = centre[x], limit = band_k * z * z;
-    // The band [lo, hi]; lo > 0, so that no missing measurement (0) falls in it.
-    const float lo = std::max(z - limit, std::numeric_limits<float>::denorm_min()), hi = z + limit;
-    float s = sum[x], c = count[x];
-    for (int i = 0; i < N; ++i) {
-      const float v = frame[i][x];
-      const bool take = (v >= lo) & (v <= hi);
-      const float taken = take ? v : 0.f, one = take ? 1.f : 0.f;
-      s += taken;
-      c += one;
-    }
+    float lo, hi, s = sum[x], c = count[x];
+    band(centre[x], band_k, lo, hi);
+    add_within_band<N>(frame, x, lo, hi, s, c);
     sum[x] = s;
     count[x] = c;
   }
 }
 
-// accumulate_within_band over any number of frames, up to kChunk per call (one kernel per count).
+// One kernel per frame count, up to kChunk frames.
 constexpr int kChunk = 8;
+using MeanKernel = void (*)(const float* const*, const float*, const float*, int, float, float*);
 using AccumulateKernel = void (*)(const float* const*, const float*, int, float, float*, float*);
+template <size_t... I>
+constexpr std::array<MeanKernel, sizeof...(I)> mean_kernels(std::index_sequence<I...>) {
+  return {&mean_within_band<static_cast<int>(I) + 1>...};
+}
 template <size_t... I>
 constexpr std::array<AccumulateKernel, sizeof...(I)> accumulate_kernels(std::index_sequence<I...>) {
   return {&accumulate_within_band<static_cast<int>(I) + 1>...};
 }
-void accumulate_within_band(const std::vector<const float*>& rows, const float* centre, int cols, float band_k,
-                            float* sum, float* count) {
-  static constexpr auto kKernels = accumulate_kernels(std::make_index_sequence<kChunk>{});
+
+// mean = the mean of the rows' values within the band around the centre, where `newest` has a
+// measurement. Windows of up to kChunk frames in one pass; longer ones kChunk frames at a time into
+// sum and count (scratch rows).
+void mean_within_band(const std::vector<const float*>& rows, const float* centre, const float* newest, int cols,
+                      float band_k, float* sum, float* count, float* mean) {
+  static constexpr auto kMeans = mean_kernels(std::make_index_sequence<kChunk>{});
+  static constexpr auto kAccumulates = accumulate_kernels(std::make_index_sequence<kChunk>{});
+  if (rows.size() <= kChunk) {
+    kMeans[rows.size() - 1](rows.data(), centre, newest, cols, band_k, mean);
+    return;
+  }
+  std::fill(sum, sum + cols, 0.f);
+  std::fill(count, count + cols, 0.f);
   for (size_t first = 0; first < rows.size(); first += kChunk) {
     const size_t n = std::min<size_t>(kChunk, rows.size() - first);
-    kKernels[n - 1](rows.data() + first, centre, cols, band_k, sum, count);
+    kAccumulates[n - 1](rows.data() + first, centre, cols, band_k, sum, count);
   }
-}
-
-// mean = sum / count where the newest frame has a measurement, else 0.
-CLUTTERSEG_ROW_KERNEL void mean_where_measured(const float* __restrict newest, const float* __restrict sum,
-                                               const float* __restrict count, int cols, float* __restrict mean) {
   for (int x = 0; x < cols; ++x) mean[x] = newest[x] > 0 ? sum[x] / std::max(count[x], 1.f) : 0.f;
 }
 
@@ -229,13 +266,8 @@ cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& pa
       // Two passes: the band around the newest value finds the values of the same surface (moving
       // surfaces keep only the newest), then the band around their mean, a steadier centre than one
       // noisy sample, takes the whole static run, so the noise falls by about sqrt(n).
-      for (int pass = 0; pass < 2; ++pass) {
-        const float* around = pass == 0 ? newest : centre.data();
-        std::fill(sum.begin(), sum.end(), 0.f);
-        std::fill(count.begin(), count.end(), 0.f);
-        accumulate_within_band(rows, around, depth.cols, band_k, sum.data(), count.data());
-        mean_where_measured(newest, sum.data(), count.data(), depth.cols, pass == 0 ? centre.data() : o);
-      }
+      mean_within_band(rows, newest, newest, depth.cols, band_k, sum.data(), count.data(), centre.data());
+      mean_within_band(rows, centre.data(), newest, depth.cols, band_k, sum.data(), count.data(), o);
     }
   });
   return out;

@@ -179,6 +179,43 @@ TEST(Segmenter, RejectsBadInput) {
   EXPECT_THROW(segment(cv::Mat(40, 64, CV_16U, cv::Scalar(1000)), cam), Error);   // size mismatch
 }
 
+TEST(Temporal, AnyWindowLengthIsTheTwoPassBandMean) {
+  // Windows shorter and longer than one kernel call takes (8 frames), against a plain two-pass loop:
+  // the mean of the window's values within the band around the newest value, then within the band
+  // around that mean.
+  for (const int frames : {1, 3, 6, 8, 9, 13}) {
+    Params::Smoothing p;
+    p.temporal_frames = frames;
+    TemporalSmoother t;
+    cv::RNG rng(static_cast<uint64_t>(frames));
+    std::vector<cv::Mat> window;
+    cv::Mat out;
+    for (int i = 0; i < frames + 2; ++i) {
+      cv::Mat d(6, 7, CV_32F);
+      rng.fill(d, cv::RNG::NORMAL, 1.0, 0.004);  // noise of about the band (10 mm at 1 m): some values fall out
+      d.setTo(0, d > 1.008);                      // and some pixels have no measurement
+      out = t.push(d, p);
+      window.push_back(d);
+      if (static_cast<int>(window.size()) > frames) window.erase(window.begin());
+    }
+    for (int y = 0; y < out.rows; ++y)
+      for (int x = 0; x < out.cols; ++x) {
+        const float newest = window.back().at<float>(y, x);
+        float centre = newest;
+        for (int pass = 0; pass < 2; ++pass) {
+          const float limit = static_cast<float>(p.temporal_band) * centre * centre;
+          float sum = 0, count = 0;
+          for (const cv::Mat& f : window) {
+            const float v = f.at<float>(y, x);
+            if (v > 0 && v >= centre - limit && v <= centre + limit) sum += v, count += 1;
+          }
+          centre = newest > 0 ? sum / std::max(count, 1.f) : 0.f;
+        }
+        ASSERT_FLOAT_EQ(out.at<float>(y, x), centre) << frames << " frames, at (" << x << ", " << y << ")";
+      }
+  }
+}
+
 TEST(Temporal, MovingBoxLeavesNoSmearAndStaticTableGetsQuieter) {
   // A box slides 4 cm per frame over a table; 1.5 mm of Gaussian depth noise on every frame.
   scenes::TestScene scene = scenes::box_on_plane();
