@@ -124,6 +124,8 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
     }
   std::vector<int> bin(static_cast<size_t>(cols));  // histogram bin of each pixel of a run
   const std::vector<float> rays = ray_x(camera, cols);
+  std::vector<float> row_rays(static_cast<size_t>(edges.rows));
+  for (int y = 0; y < edges.rows; ++y) row_rays[static_cast<size_t>(y)] = ray_y(camera, y);
   for (const Run& run : runs) {
     ComponentSums& s = sums[static_cast<size_t>(run.component)];
     if (s.area < min_size) continue;
@@ -132,7 +134,8 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
     const size_t first = s.pixels.size();
     s.pixels.resize(first + static_cast<size_t>(n));  // within the reserved area: no reallocation
     std::iota(s.pixels.begin() + static_cast<std::ptrdiff_t>(first), s.pixels.end(), run.y * cols + run.x0);
-    add_point_run(depth.ptr<float>(run.y) + run.x0, rays.data() + run.x0, ray_y(camera, run.y), n, s.point);
+    add_point_run(depth.ptr<float>(run.y) + run.x0, rays.data() + run.x0, row_rays[static_cast<size_t>(run.y)], n,
+                  s.point);
     add_run(nrm, n, s.normal);
     normal_bins(nrm, n, bins, bin.data());
     int* const counts = s.histogram.data();
