@@ -87,8 +87,8 @@ void Normals(benchmark::State& s) {
 
 // The inputs of the later stages, computed once per frame (outside the timed loop).
 struct Stages {
-  cv::Mat depth, points, normals, edges;
-  NormalPlanes normal_planes;  // the layout the pipeline hands to the edge stage
+  cv::Mat depth, points, edges;
+  NormalPlanes normals;
   Patches patches;
 };
 const std::vector<Stages>& stages(int subsample) {
@@ -104,8 +104,8 @@ const std::vector<Stages>& stages(int subsample) {
     s.depth = median_depth(raw);
     s.points = depth_to_points(s.depth, in.camera);
     s.normals = compute_normals(s.depth, in.camera, step, px.odd(kParams.normals.smooth_ksize),
-                                relative_jump_limit(kParams.edges, step, in.camera), &s.normal_planes);
-    s.edges = edge_mask(normal_edge_value(s.normal_planes, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
+                                relative_jump_limit(kParams.edges, step, in.camera));
+    s.edges = edge_mask(normal_edge_value(s.normals, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
                         relative_jump_limit(kParams.edges, 1, in.camera));
     s.patches = extract_patches(s.edges, s.depth, in.camera, s.normals, kParams.patches, px.area(kParams.patches.min_size_px));
     out.push_back(std::move(s));
@@ -122,7 +122,7 @@ void per_stage_frame(benchmark::State& state, Body body) {
 void Edges(benchmark::State& st) {
   per_stage_frame(st, [](const Stages& s, const Camera& c) {
     const PixelScale px(c.fx, c.fy);
-    return edge_mask(normal_edge_value(s.normal_planes, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
+    return edge_mask(normal_edge_value(s.normals, px.length(kParams.edges.step_px)), s.depth, kParams.edges.theta,
                      relative_jump_limit(kParams.edges, 1, c));
   });
 }
@@ -150,7 +150,7 @@ void OpenCVCalls(benchmark::State& st) {
     const int ksize = PixelScale(c.fx, c.fy).odd(kParams.normals.smooth_ksize);
     cv::Mat median, smoothed, labels;
     cv::medianBlur(s.depth, median, 3);
-    for (const cv::Mat& plane : s.normal_planes)
+    for (const cv::Mat& plane : s.normals)
       cv::GaussianBlur(plane, smoothed, cv::Size(ksize, ksize), 0, 0, cv::BORDER_REPLICATE);
     return cv::connectedComponents(s.edges == 0, labels, 4, CV_32S);
   });
@@ -162,10 +162,9 @@ size_t presegment(TemporalSmoother& t, const cv::Mat& raw, const Camera& c) {
   const PixelScale px(c.fx, c.fy);
   const int step = px.length(kParams.normals.step_px), edge_step = px.length(kParams.edges.step_px);
   const cv::Mat depth = t.push(median_depth(raw), kParams.smoothing);
-  NormalPlanes planes;
-  const cv::Mat normals = compute_normals(depth, c, step, px.odd(kParams.normals.smooth_ksize),
-                                          relative_jump_limit(kParams.edges, step, c), &planes);
-  const cv::Mat edges = edge_mask(normal_edge_value(planes, edge_step), depth, kParams.edges.theta,
+  const NormalPlanes normals = compute_normals(depth, c, step, px.odd(kParams.normals.smooth_ksize),
+                                               relative_jump_limit(kParams.edges, step, c));
+  const cv::Mat edges = edge_mask(normal_edge_value(normals, edge_step), depth, kParams.edges.theta,
                                   relative_jump_limit(kParams.edges, 1, c));
   return extract_patches(edges, depth, c, normals, kParams.patches, px.area(kParams.patches.min_size_px)).patches.size();
 }

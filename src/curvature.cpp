@@ -92,9 +92,9 @@ struct BinnedPixels {
   std::vector<int> start;   // bins*bins + 1 offsets into `pixels`
   std::vector<int> pixels;  // valid pixels, ordered by bin
 
-  BinnedPixels(const Patch& patch, int bins, const cv::Mat& points, const cv::Mat& normals) {
+  BinnedPixels(const Patch& patch, int bins, const cv::Mat& points, const NormalPlanes& normals) {
     const auto* pts = points.ptr<cv::Vec3f>();
-    const auto* nrm = normals.ptr<cv::Vec3f>();
+    const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>();
     const size_t stride = std::max<size_t>(1, patch.pixels.size() / kBinnedSamples);
     std::vector<int> sampled, bin_of;
     start.assign(static_cast<size_t>(bins * bins) + 1, 0);
@@ -102,7 +102,7 @@ struct BinnedPixels {
       const int i = patch.pixels[k];
       if (!(pts[i][2] > 0)) continue;
       sampled.push_back(i);
-      bin_of.push_back(normal_bin(nrm[i], bins));
+      bin_of.push_back(normal_bin(nx[i], ny[i], bins));
       ++start[static_cast<size_t>(bin_of.back()) + 1];
     }
     for (size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
@@ -186,22 +186,22 @@ double histogram_similarity(const std::vector<float>& a, const std::vector<float
   return s;
 }
 
-int convexity(const Patch& patch, const cv::Mat& points, const cv::Mat& normals, int bins) {
+int convexity(const Patch& patch, const cv::Mat& points, const NormalPlanes& normals, int bins) {
   // Physically: on a convex surface the (outward, camera-facing) normal turns the way one walks,
   // dn = S dp with a positive shape operator S; on a concave one it turns against. We find the
   // direction e in which the normals vary most (the major axis of the histogram blob, paper Eq. 4)
   // and correlate n.e with p.e over the patch: the sign is the sign of the curvature along e.
   // One pass of first and second moments; large patches are subsampled on a fixed stride.
   const auto* pts = points.ptr<cv::Vec3f>();
-  const auto* nrm = normals.ptr<cv::Vec3f>();
+  const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
   const size_t stride = std::max<size_t>(1, patch.pixels.size() / kConvexitySamples);
   Eigen::Vector3d sn = Eigen::Vector3d::Zero(), sp = Eigen::Vector3d::Zero();
   Eigen::Matrix3d snn = Eigen::Matrix3d::Zero(), snp = Eigen::Matrix3d::Zero(), spp = Eigen::Matrix3d::Zero();
   double count = 0;
   for (size_t k = 0; k < patch.pixels.size(); k += stride) {
     const int i = patch.pixels[k];
-    if (!(pts[i][2] > 0) || (nrm[i][0] == 0 && nrm[i][1] == 0 && nrm[i][2] == 0)) continue;
-    const Eigen::Vector3d n = vec(nrm[i]).cast<double>(), p = vec(pts[i]).cast<double>();
+    if (!(pts[i][2] > 0) || (nx[i] == 0 && ny[i] == 0 && nz[i] == 0)) continue;
+    const Eigen::Vector3d n(nx[i], ny[i], nz[i]), p = vec(pts[i]).cast<double>();
     sn += n; sp += p;
     snn.noalias() += n * n.transpose();
     snp.noalias() += n * p.transpose();
@@ -225,13 +225,16 @@ int convexity(const Patch& patch, const cv::Mat& points, const cv::Mat& normals,
 
 std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, const std::vector<PatchPair>& linked,
                                            const cv::Mat& assigned_labels, const cv::Mat& points,
-                                           const cv::Mat& normals, const Camera& camera, const Params& params) {
+                                           const NormalPlanes& normals, const Camera& camera, const Params& params) {
   std::vector<CurvatureLink> out;
   const auto& p = params.curvature;
   if (!p.enabled || (!p.open_objects && !p.occluded)) return out;
-  if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || normals.type() != CV_32FC3 ||
-      assigned_labels.size() != points.size() || normals.size() != points.size())
-    throw Error("curvature_links: labels (CV_32S), points and normals (CV_32FC3) must be images of one size");
+  const bool planes_ok = std::all_of(normals.begin(), normals.end(), [&](const cv::Mat& plane) {
+    return plane.type() == CV_32F && plane.size() == points.size() && plane.isContinuous();
+  });
+  if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || assigned_labels.size() != points.size() ||
+      !planes_ok)
+    throw Error("curvature_links: labels (CV_32S), points (CV_32FC3) and normal planes (CV_32F) must be images of one size");
   std::vector<PatchPair> known = linked;
   for (auto& pair : known)
     if (pair.first > pair.second) std::swap(pair.first, pair.second);

@@ -4,7 +4,9 @@
 
 namespace clutterseg {
 
-cv::Mat render_normals(const cv::Mat& normals) {
+cv::Mat render_normals(const NormalPlanes& planes) {
+  cv::Mat normals;
+  cv::merge(planes.data(), planes.size(), normals);
   cv::Mat bgr(normals.size(), CV_8UC3, cv::Scalar::all(0));
   normals.forEach<cv::Vec3f>([&](const cv::Vec3f& n, const int* pos) {
     if (n[2] == 0) return;

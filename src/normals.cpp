@@ -47,19 +47,15 @@ CLUTTERSEG_ROW_KERNEL void raw_normal_row(const float* __restrict up, const floa
   }
 }
 
-// Renormalises one row of smoothed normals, in place in the planes and interleaved into `out`;
-// 0 where there is no measurement.
+// Renormalises one row of smoothed normals in place; 0 where there is no measurement.
 CLUTTERSEG_ROW_KERNEL void normalize_row(const float* __restrict z, int cols, float* __restrict nx,
-                                         float* __restrict ny, float* __restrict nz, float* __restrict out) {
+                                         float* __restrict ny, float* __restrict nz) {
   for (int x = 0; x < cols; ++x) {
     const float len2 = nx[x] * nx[x] + ny[x] * ny[x] + nz[x] * nz[x];
     const float inv = ((z[x] > 0) & (len2 > 1e-12f)) ? 1.f / std::sqrt(len2) : 0.f;
     nx[x] *= inv;
     ny[x] *= inv;
     nz[x] *= inv;
-    out[3 * x] = nx[x];
-    out[3 * x + 1] = ny[x];
-    out[3 * x + 2] = nz[x];
   }
 }
 
@@ -87,8 +83,7 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
   return static_cast<float>(params.jump_slope * step / std::min(camera.fx, camera.fy));
 }
 
-cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit,
-                        NormalPlanes* planes_out) {
+NormalPlanes compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit) {
   const int rows = depth.rows, cols = depth.cols, s = step;
   std::vector<float> column_ray(static_cast<size_t>(cols + 2 * s));  // (u - cx) / fx per padded column
   for (int u = 0; u < cols + 2 * s; ++u) column_ray[static_cast<size_t>(u)] = static_cast<float>((u - s - camera.cx) / camera.fx);
@@ -110,14 +105,11 @@ cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, in
   });
   if (ksize > 1)
     for (auto& p : planes) cv::GaussianBlur(p, p, cv::Size(ksize, ksize), 0, 0, cv::BORDER_REPLICATE);
-  cv::Mat normals(depth.size(), CV_32FC3);
   parallel_for_rows(rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
-      normalize_row(depth.ptr<float>(y), cols, planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y),
-                    normals.ptr<float>(y));
+      normalize_row(depth.ptr<float>(y), cols, planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
   });
-  if (planes_out) *planes_out = std::move(planes);
-  return normals;
+  return planes;
 }
 
 }  // namespace clutterseg

@@ -34,64 +34,60 @@ constexpr int kCounters = 4;
 using Floats = float __attribute__((vector_size(16)));
 using Doubles = double __attribute__((vector_size(32)));
 
-// sum[d] += v[3 k + d] for the n interleaved 3-vectors v. Four vectors (12 floats) at a time go into
-// three sums of 4 doubles, lanes (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3): three independent chains of
-// adds instead of one, whose latency bound the loop. The order differs from a plain loop only in the
-// last bits of the double sums, far below the float results.
-CLUTTERSEG_AVX2_KERNEL void add_run(const float* __restrict v, int n, double* __restrict sum) {
-  Doubles a = {0, 0, 0, 0}, b = a, c = a;
+// sum[d] += the n values of three float sequences (d = 0, 1, 2) as doubles: four at a time into the
+// lanes of a 4-double vector each (lane k mod 4), three independent chains of adds instead of one
+// whose latency would bound the loop, then the last n mod 4 one at a time. four(k, f) gives the
+// sequences' values k .. k + 3, one(k, d) value k of sequence d. The order differs from a plain loop
+// only in the last bits of the double sums, far below the float results.
+template <typename Four, typename One>
+inline void add_three(int n, double* __restrict sum, Four four, One one) {
+  Doubles lanes[3] = {};
   int k = 0;
   for (; k + 4 <= n; k += 4) {
     Floats f[3];
-    std::memcpy(f, v + 3 * k, sizeof f);
-    a += __builtin_convertvector(f[0], Doubles);
-    b += __builtin_convertvector(f[1], Doubles);
-    c += __builtin_convertvector(f[2], Doubles);
+    four(k, f);
+    for (int d = 0; d < 3; ++d) lanes[d] += __builtin_convertvector(f[d], Doubles);
   }
-  sum[0] += a[0] + a[3] + b[2] + c[1];
-  sum[1] += a[1] + b[0] + b[3] + c[2];
-  sum[2] += a[2] + b[1] + c[0] + c[3];
+  for (int d = 0; d < 3; ++d) sum[d] += lanes[d][0] + lanes[d][1] + lanes[d][2] + lanes[d][3];
   for (; k < n; ++k)
-    for (int d = 0; d < 3; ++d) sum[d] += v[3 * k + d];
+    for (int d = 0; d < 3; ++d) sum[d] += one(k, d);
 }
 
-// add_run of the n points (ray_x[k] z[k], ray_y z[k], z[k]) of a run of depths, without reading the
-// point cloud (a third of the bytes): the same float products as depth_to_points, summed in the same
-// order as add_run sums them, so the sums have the same bits.
+// The sums of a run of n normals (planes x, y, z).
+CLUTTERSEG_AVX2_KERNEL void add_normal_run(const float* __restrict nx, const float* __restrict ny,
+                                           const float* __restrict nz, int n, double* __restrict sum) {
+  const float* plane[3] = {nx, ny, nz};
+  add_three(
+      n, sum, [&](int k, Floats* f) { for (int d = 0; d < 3; ++d) std::memcpy(&f[d], plane[d] + k, sizeof f[d]); },
+      [&](int k, int d) { return plane[d][k]; });
+}
+
+// The sums of a run of n points (ray_x[k] z[k], ray_y z[k], z[k]) from its depths, without reading the
+// point cloud (a third of the bytes): the same float products as depth_to_points, so the same sums.
 CLUTTERSEG_AVX2_KERNEL void add_point_run(const float* __restrict z, const float* __restrict ray_x, float ray_y,
                                           int n, double* __restrict sum) {
-  Doubles x = {0, 0, 0, 0}, y = x, s = x;
-  int k = 0;
-  for (; k + 4 <= n; k += 4) {
-    Floats fz, rx;
-    std::memcpy(&fz, z + k, sizeof fz);
-    std::memcpy(&rx, ray_x + k, sizeof rx);
-    x += __builtin_convertvector(rx * fz, Doubles);
-    y += __builtin_convertvector(ray_y * fz, Doubles);
-    s += __builtin_convertvector(fz, Doubles);
-  }
-  sum[0] += x[0] + x[1] + x[2] + x[3];
-  sum[1] += y[0] + y[1] + y[2] + y[3];
-  sum[2] += s[0] + s[1] + s[2] + s[3];
-  for (; k < n; ++k) {
-    sum[0] += ray_x[k] * z[k];
-    sum[1] += ray_y * z[k];
-    sum[2] += z[k];
-  }
+  add_three(
+      n, sum,
+      [&](int k, Floats* f) {
+        Floats rx;
+        std::memcpy(&f[2], z + k, sizeof f[2]);
+        std::memcpy(&rx, ray_x + k, sizeof rx);
+        f[0] = rx * f[2];
+        f[1] = ray_y * f[2];
+      },
+      [&](int k, int d) { return d == 0 ? ray_x[k] * z[k] : d == 1 ? ray_y * z[k] : z[k]; });
 }
 
-// normal_bin of each of n interleaved normals, in one vectorised pass.
-CLUTTERSEG_AVX2_KERNEL void normal_bins(const float* __restrict normals, int n, int bins, int* __restrict out) {
-  for (int k = 0; k < n; ++k) {
-    const cv::Vec3f normal(normals[3 * k], normals[3 * k + 1], normals[3 * k + 2]);
-    out[k] = normal_bin(normal, bins);
-  }
+// normal_bin of each of n normals (planes x, y), in one vectorised pass.
+CLUTTERSEG_AVX2_KERNEL void normal_bins(const float* __restrict nx, const float* __restrict ny, int n, int bins,
+                                        int* __restrict out) {
+  for (int k = 0; k < n; ++k) out[k] = normal_bin(nx[k], ny[k], bins);
 }
 
 }  // namespace
 
-Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera, const cv::Mat& normals,
-                        const Params::Patches& params, int min_size) {
+Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
+                        const NormalPlanes& normals, const Params::Patches& params, int min_size) {
   // OpenCV's labelling without its statistics: the pass below gathers them together with ours
   // (OpenCV's own statistics pass costs more than the labelling itself).
   cv::Mat components;
@@ -130,14 +126,16 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
     ComponentSums& s = sums[static_cast<size_t>(run.component)];
     if (s.area < min_size) continue;
     const int n = run.x1 - run.x0;
-    const float* nrm = &normals.ptr<cv::Vec3f>(run.y)[run.x0][0];
+    const float* nx = normals[0].ptr<float>(run.y) + run.x0;
+    const float* ny = normals[1].ptr<float>(run.y) + run.x0;
+    const float* nz = normals[2].ptr<float>(run.y) + run.x0;
     const size_t first = s.pixels.size();
     s.pixels.resize(first + static_cast<size_t>(n));  // within the reserved area: no reallocation
     std::iota(s.pixels.begin() + static_cast<std::ptrdiff_t>(first), s.pixels.end(), run.y * cols + run.x0);
     add_point_run(depth.ptr<float>(run.y) + run.x0, rays.data() + run.x0, row_rays[static_cast<size_t>(run.y)], n,
                   s.point);
-    add_run(nrm, n, s.normal);
-    normal_bins(nrm, n, bins, bin.data());
+    add_normal_run(nx, ny, nz, n, s.normal);
+    normal_bins(nx, ny, n, bins, bin.data());
     int* const counts = s.histogram.data();
     const int cells = bins * bins;
     int k = 0;

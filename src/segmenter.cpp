@@ -72,10 +72,9 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   if (p.smoothing.temporal) depth = temporal_.push(depth, p.smoothing);          // a) temporal smoothing
   watch.mark("temporal_smoothing");
   r.depth = depth;
-  NormalPlanes normals;
-  r.normals = compute_normals(depth, camera, step, px.odd(p.normals.smooth_ksize), jump, &normals);  // a) normals
+  r.normals = compute_normals(depth, camera, step, px.odd(p.normals.smooth_ksize), jump);  // a) normals
   watch.mark("normals");
-  r.edge_value = normal_edge_value(normals, edge_step);                          // b) normal edges
+  r.edge_value = normal_edge_value(r.normals, edge_step);                        // b) normal edges
   r.edges = edge_mask(r.edge_value, r.depth, p.edges.theta, pixel_jump);
   watch.mark("edges");
   Patches patches = extract_patches(r.edges, r.depth, camera, r.normals, p.patches,  // c) surface patches

@@ -20,12 +20,13 @@ std::vector<CurvatureLink> links_of(const Segmented& s, const TestScene& scene, 
 // A hand-made patch on a cylinder of radius r about the camera's y axis at depth z0 (+1: the outside
 // seen from outside; -1: the inside seen from inside), 60 degrees of arc in view.
 struct Synthetic {
-  cv::Mat points, normals;
+  cv::Mat points;
+  NormalPlanes normals;
   Patch patch;
 };
 Synthetic cylinder_patch(int side) {
   const int w = 60, h = 20;
-  Synthetic s{cv::Mat(h, w, CV_32FC3), cv::Mat(h, w, CV_32FC3), {}};
+  Synthetic s{cv::Mat(h, w, CV_32FC3), {cv::Mat(h, w, CV_32F), cv::Mat(h, w, CV_32F), cv::Mat(h, w, CV_32F)}, {}};
   const float r = 0.05f, z0 = 1.f;
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) {
@@ -35,7 +36,7 @@ Synthetic cylinder_patch(int side) {
       const float x = r * std::sin(a), z = z0 - static_cast<float>(side) * r * std::cos(a);
       const Eigen::Vector3f n(static_cast<float>(side) * std::sin(a), 0, -std::cos(a));
       s.points.at<cv::Vec3f>(v, u) = {x, 0.002f * static_cast<float>(v), z};
-      s.normals.at<cv::Vec3f>(v, u) = {n.x(), n.y(), n.z()};
+      for (int d = 0; d < 3; ++d) s.normals[static_cast<size_t>(d)].at<float>(v, u) = n(d);
       s.patch.pixels.push_back(v * w + u);
     }
   return s;
@@ -58,7 +59,7 @@ TEST(Convexity, OutsideOfACylinderIsConvexItsInsideConcave) {
   EXPECT_EQ(convexity(inside.patch, inside.points, inside.normals, 11), -1);
   // A plane: the normals do not turn, nothing to decide.
   Synthetic flat = cylinder_patch(+1);
-  flat.normals.setTo(cv::Scalar(0, 0, -1));
+  for (int d = 0; d < 3; ++d) flat.normals[static_cast<size_t>(d)].setTo(d == 2 ? -1 : 0);
   EXPECT_EQ(convexity(flat.patch, flat.points, flat.normals, 11), 0);
 }
 

@@ -109,8 +109,8 @@ TEST(Temporal, AveragesStaticNoiseAndKeepsMotion) {
 TEST(Normals, PlaneFacingTheCameraAndTiltedPlane) {
   Camera cam = synth::default_camera(64, 48);
   cv::Mat flat(48, 64, CV_32F, cv::Scalar(1.0f));
-  cv::Mat n = compute_normals(flat, cam, 1, 5, 0.1f);
-  cv::Vec3f c = n.at<cv::Vec3f>(24, 32);
+  NormalPlanes n = compute_normals(flat, cam, 1, 5, 0.1f);
+  cv::Vec3f c(n[0].at<float>(24, 32), n[1].at<float>(24, 32), n[2].at<float>(24, 32));
   EXPECT_NEAR(c[2], -1.0, 1e-4);
   // Plane z = 1 + 0.5 y (tilted about the x axis): normal (0, -0.5, 1) normalised, facing the camera.
   cv::Mat tilted(48, 64, CV_32F);
@@ -120,7 +120,7 @@ TEST(Normals, PlaneFacingTheCameraAndTiltedPlane) {
       tilted.at<float>(v, u) = static_cast<float>(1.0 / (1.0 - 0.5 * ry));
     }
   n = compute_normals(tilted, cam, 1, 5, 0.1f);
-  c = n.at<cv::Vec3f>(24, 32);
+  c = cv::Vec3f(n[0].at<float>(24, 32), n[1].at<float>(24, 32), n[2].at<float>(24, 32));
   const Eigen::Vector3f expected = Eigen::Vector3f(0, 0.5f, -1).normalized();
   EXPECT_NEAR(c[1], expected.y(), 1e-3);
   EXPECT_NEAR(c[2], expected.z(), 1e-3);
@@ -166,7 +166,9 @@ TEST(Patches, SmallComponentsAreDropped) {
   edges.row(20).setTo(255);
   edges(cv::Rect(0, 0, 5, 5)).setTo(255);
   edges.at<uchar>(2, 2) = 0;  // a 1-pixel island
-  cv::Mat depth(40, 40, CV_32F, cv::Scalar(1)), nrm(40, 40, CV_32FC3, cv::Scalar(0, 0, -1));
+  cv::Mat depth(40, 40, CV_32F, cv::Scalar(1));
+  const NormalPlanes nrm = {cv::Mat(40, 40, CV_32F, cv::Scalar(0)), cv::Mat(40, 40, CV_32F, cv::Scalar(0)),
+                            cv::Mat(40, 40, CV_32F, cv::Scalar(-1))};
   const Patches p = extract_patches(edges, depth, synth::default_camera(40, 40), nrm, Params::Patches{}, 10);
   EXPECT_EQ(p.patches.size(), 2u);
   EXPECT_EQ(p.labels.at<int>(2, 2), 0);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "clutterseg/adjacency.hpp"
+#include "clutterseg/normals.hpp"
 
 namespace clutterseg {
 
@@ -10,7 +11,7 @@ double histogram_similarity(const std::vector<float>& a, const std::vector<float
 
 // Convexity of a curved patch from its normal histogram (paper Eq. 4, defined physically: a convex
 // surface's normals turn away from its centre). +1 convex, -1 concave, 0 undecided.
-int convexity(const Patch& patch, const cv::Mat& points, const cv::Mat& normals, int bins);
+int convexity(const Patch& patch, const cv::Mat& points, const NormalPlanes& normals, int bins);
 
 struct CurvatureLink {
   PatchPair pair;
@@ -23,7 +24,7 @@ struct CurvatureLink {
 std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches,
                                            const std::vector<PatchPair>& linked,
                                            const cv::Mat& assigned_labels, const cv::Mat& points,
-                                           const cv::Mat& normals, const Camera& camera,
+                                           const NormalPlanes& normals, const Camera& camera,
                                            const Params& params);
 
 }  // namespace clutterseg

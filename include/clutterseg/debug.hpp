@@ -5,7 +5,7 @@
 
 namespace clutterseg {
 
-cv::Mat render_normals(const cv::Mat& normals);          // xyz -> RGB, black = none
+cv::Mat render_normals(const NormalPlanes& normals);     // xyz -> RGB, black = none
 cv::Mat render_edges(const cv::Mat& edges);              // white surfaces, black edges
 cv::Mat render_edge_value(const cv::Mat& edge_value);    // grey: 1 (flat) white .. 0.5 and below black
 cv::Mat render_labels(const cv::Mat& labels);            // distinct colours per id, black = 0

@@ -19,16 +19,15 @@ inline float ray_y(const Camera& camera, int v) {           // (v - cy) / fy
 // Largest |z(q) - z(p)| / z(p) between pixels `step` apart that is not a depth discontinuity.
 float relative_jump_limit(const Params::Edges& params, int step, const Camera& camera);
 
-// Normals as three CV_32F planes (x, y, z): the layout the edge stage reads.
+// Normals as three CV_32F planes (x, y, z): every per-pixel loop reads them as plain float arrays, with
+// no interleaving to undo. cv::merge gives the CV_32FC3 image.
 using NormalPlanes = std::array<cv::Mat, 3>;
 
-// Normals (CV_32FC3, unit, facing the camera; (0,0,0) = none) of the organized 3D points of `depth`
-// (CV_32F metres): the cross product of the horizontal and vertical neighbour differences at distance
-// `step`, then a Gaussian of size `ksize` and renormalisation. A difference across a depth
-// discontinuity (jump_limit, relative to z) falls back to the one-sided difference. step and ksize are
-// the scaled values (PixelScale). With `planes`, the same normals also as planes (written in the same
-// pass: no split or merge in between).
-cv::Mat compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit,
-                        NormalPlanes* planes = nullptr);
+// Normals (unit, facing the camera; (0,0,0) = none) of the organized 3D points of `depth` (CV_32F
+// metres): the cross product of the horizontal and vertical neighbour differences at distance `step`,
+// then a Gaussian of size `ksize` and renormalisation. A difference across a depth discontinuity
+// (jump_limit, relative to z) falls back to the one-sided difference. step and ksize are the scaled
+// values (PixelScale).
+NormalPlanes compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit);
 
 }  // namespace clutterseg

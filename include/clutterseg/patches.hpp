@@ -1,6 +1,7 @@
 // Paper c): surface patches = connected components of non-edge pixels, with per-patch statistics.
 #pragma once
 
+#include "clutterseg/normals.hpp"
 #include "clutterseg/params.hpp"
 #include "clutterseg/types.hpp"
 
@@ -13,14 +14,14 @@ struct Patches {
 
 // 4-connected components of the non-edge pixels; components smaller than min_size (already scaled
 // to the resolution) are dropped. Statistics per patch from the depth (CV_32F metres; the centroid of
-// the points depth_to_points gives) and the normals (CV_32FC3).
-Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera, const cv::Mat& normals,
-                        const Params::Patches& params, int min_size);
+// the points depth_to_points gives) and the normals.
+Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
+                        const NormalPlanes& normals, const Params::Patches& params, int min_size);
 
-// The bin of a unit normal in the (x, y) histogram of normals: bins x bins cells over [-1, 1]^2.
-inline int normal_bin(const cv::Vec3f& n, int bins) {
+// The bin of a unit normal (x, y, z) in the (x, y) histogram of normals: bins x bins cells over [-1, 1]^2.
+inline int normal_bin(float x, float y, int bins) {
   auto bin = [bins](float c) { return std::clamp(static_cast<int>((c + 1.f) * 0.5f * bins), 0, bins - 1); };
-  return bin(n[1]) * bins + bin(n[0]);
+  return bin(y) * bins + bin(x);
 }
 
 }  // namespace clutterseg

@@ -3,6 +3,7 @@
 
 #include <optional>
 
+#include "clutterseg/normals.hpp"
 #include "clutterseg/params.hpp"
 #include "clutterseg/patches.hpp"
 #include "clutterseg/smoothing.hpp"
@@ -22,7 +23,7 @@ struct Result {
   // Intermediate images, for debugging and the debug views.
   cv::Mat depth;        // CV_32F metres after smoothing, 0 = none
   cv::Mat points;       // CV_32FC3 camera frame
-  cv::Mat normals;      // CV_32FC3 unit, (0,0,0) = none
+  NormalPlanes normals; // unit, as x, y, z planes (CV_32F), (0,0,0) = none
   cv::Mat edge_value;   // CV_32F mean |n.n_q|
   cv::Mat edges;        // CV_8U 255 = edge
   cv::Mat core_patch_labels;  // CV_32S patches before edge pixels were assigned
