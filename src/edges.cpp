@@ -116,14 +116,29 @@ cv::Mat normal_edge_value(const NormalPlanes& n, int step) {
 cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& depth, double theta, float jump_limit) {
   const int rows = depth.rows, cols = depth.cols;
   cv::Mat edges(depth.size(), CV_8U);
-  // One column of replicated depth on each side: a pixel outside the image makes no jump.
-  cv::Mat padded;
-  cv::copyMakeBorder(depth, padded, 0, 0, 1, 1, cv::BORDER_REPLICATE);
+  // Rows with one replicated column on either side (a pixel outside the image makes no jump), each
+  // copied once into a ring of three small buffers rather than a padded copy of the whole image.
   parallel_for_rows(rows, [&](int begin, int end) {
+    const size_t stride = static_cast<size_t>(cols) + 2;
+    std::vector<float> ring(3 * stride);
+    int held[3] = {-1, -1, -1};  // the image row in each buffer
+    const auto padded = [&](int y) {
+      const int slot = y % 3;
+      float* row = ring.data() + static_cast<size_t>(slot) * stride + 1;
+      if (held[slot] != y) {
+        const float* from = depth.ptr<float>(y);
+        std::copy_n(from, cols, row);
+        row[-1] = from[0];
+        row[cols] = from[cols - 1];
+        held[slot] = y;
+      }
+      return row;
+    };
     for (int y = begin; y < end; ++y) {
-      const float* z = padded.ptr<float>(y) + 1;
-      const float* up = y > 0 ? padded.ptr<float>(y - 1) + 1 : z;
-      const float* down = y + 1 < rows ? padded.ptr<float>(y + 1) + 1 : z;
+      // The row itself stands in above the first row and below the last one.
+      const float* up = padded(std::max(y - 1, 0));
+      const float* z = padded(y);
+      const float* down = padded(std::min(y + 1, rows - 1));
       edge_row(up, z, down, edge_value.ptr<float>(y), cols, static_cast<float>(theta), jump_limit, edges.ptr<uchar>(y));
     }
   });
