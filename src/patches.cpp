@@ -1,5 +1,6 @@
 #include "clutterseg/patches.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstring>
@@ -88,6 +89,10 @@ CLUTTERSEG_AVX2_KERNEL void normal_bins(const float* __restrict nx, const float*
 
 Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
                         const NormalPlanes& normals, const Params::Patches& params, int min_size) {
+  const auto fits = [&](const cv::Mat& m, int type) { return m.type() == type && m.size() == edges.size(); };
+  const bool planes_fit = std::all_of(normals.begin(), normals.end(), [&](const cv::Mat& n) { return fits(n, CV_32F); });
+  if (!fits(edges, CV_8U) || !fits(depth, CV_32F) || !planes_fit)
+    throw Error("extract_patches: edges (CV_8U), depth and the normal planes (CV_32F) must be images of one size");
   // OpenCV's labelling without its statistics: the pass below gathers them together with ours
   // (OpenCV's own statistics pass costs more than the labelling itself).
   cv::Mat components;

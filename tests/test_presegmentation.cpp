@@ -172,6 +172,8 @@ TEST(Patches, SmallComponentsAreDropped) {
   const Patches p = extract_patches(edges, depth, synth::default_camera(40, 40), nrm, Params::Patches{}, 10);
   EXPECT_EQ(p.patches.size(), 2u);
   EXPECT_EQ(p.labels.at<int>(2, 2), 0);
+  // Inputs that do not fit each other are refused, not read out of bounds.
+  EXPECT_THROW(extract_patches(edges, depth(cv::Rect(0, 0, 40, 30)), synth::default_camera(40, 40), nrm, {}, 10), Error);
 }
 
 TEST(Segmenter, RejectsBadInput) {
