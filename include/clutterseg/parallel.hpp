@@ -10,7 +10,8 @@
 // (-ffp-contract=off), so the versions give identical bits. CLUTTERSEG_AVX2_KERNEL leaves out the
 // AVX-512 version: for kernels over short runs and the hole-border mask, which measured slower 16 wide
 // (docs/BENCHMARKS.md), and for float sums vectorised with `omp simd reduction`, whose last bits depend
-// on the vector width (AVX-512 machines then give the bits AVX2 machines give).
+// on the vector width (AVX-512 machines then give the bits AVX2 machines give; a CPU without AVX2 may
+// differ from both in those last bits).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define CLUTTERSEG_ROW_KERNEL __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 #define CLUTTERSEG_AVX2_KERNEL __attribute__((target_clones("avx2", "default")))
