@@ -85,9 +85,12 @@ float relative_jump_limit(const Params::Edges& params, int step, const Camera& c
 
 NormalPlanes compute_normals(const cv::Mat& depth, const Camera& camera, int step, int ksize, float jump_limit) {
   const int rows = depth.rows, cols = depth.cols, s = step;
-  std::vector<float> column_ray(static_cast<size_t>(cols + 2 * s));  // (u - cx) / fx per padded column
-  for (int u = 0; u < cols + 2 * s; ++u) column_ray[static_cast<size_t>(u)] = static_cast<float>((u - s - camera.cx) / camera.fx);
-  const auto row_ray = [&](int v) { return static_cast<float>((v - camera.cy) / camera.fy); };
+  // The rays of depth_to_points, padded by s columns on either side (read only for neighbours inside
+  // the image: the ones outside are holes).
+  std::vector<float> column_ray(static_cast<size_t>(cols + 2 * s), 0.f);
+  const std::vector<float> rays = ray_x(camera, cols);
+  std::copy(rays.begin(), rays.end(), column_ray.begin() + s);
+  const auto row_ray = [&](int v) { return ray_y(camera, v); };
   // A neighbour outside the image is "no measurement", like a hole: rows outside read a row of zeros,
   // and each row is copied between s zeros on either side (a small buffer, not a padded image).
   const std::vector<float> zeros(static_cast<size_t>(cols), 0.f);
