@@ -85,6 +85,48 @@ CLUTTERSEG_AVX2_KERNEL void normal_bins(const float* __restrict nx, const float*
   for (int k = 0; k < n; ++k) out[k] = normal_bin(nx[k], ny[k], bins);
 }
 
+// The runs of non-edge pixels, row after row, and their 4-connected components: two runs of adjacent
+// rows that share a column are joined (union-find over runs, the smaller index as root), and components
+// are numbered 1, 2, ... in raster order of their first pixel, as cv::connectedComponents numbers them.
+// Returns the number of components plus one (0 is the edges). The runs are what the statistics below
+// read, so labelling them directly costs a few operations per run instead of a pass over every pixel.
+int label_runs(const cv::Mat& edges, std::vector<Run>& runs) {
+  std::vector<int> parent;
+  const auto root = [&](int i) {
+    while (parent[static_cast<size_t>(i)] != i)  // path halving: each step shortens the path
+      i = parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+    return i;
+  };
+  const int cols = edges.cols;
+  size_t previous_row = 0;  // index of the previous row's first run
+  for (int y = 0; y < edges.rows; ++y) {
+    const uchar* edge = edges.ptr<uchar>(y);
+    const size_t row = runs.size();
+    for (int x = first_zero(edge, 0, cols); x < cols; x = first_zero(edge, x, cols)) {
+      const int start = x;
+      x = first_nonzero(edge, x, cols);
+      parent.push_back(static_cast<int>(runs.size()));
+      runs.push_back({0, y, start, x});
+    }
+    // Walk both rows' runs left to right; each step drops the run that ends first.
+    for (size_t a = previous_row, b = row; y > 0 && a < row && b < runs.size();) {
+      if (runs[a].x0 < runs[b].x1 && runs[b].x0 < runs[a].x1) {
+        const int ra = root(static_cast<int>(a)), rb = root(static_cast<int>(b));
+        parent[static_cast<size_t>(std::max(ra, rb))] = std::min(ra, rb);
+      }
+      if (runs[a].x1 <= runs[b].x1) ++a; else ++b;
+    }
+    previous_row = row;
+  }
+  // A root is its component's first run in raster order; every other run comes after its root.
+  int count = 1;
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const int r = root(static_cast<int>(i));
+    runs[i].component = r == static_cast<int>(i) ? count++ : runs[static_cast<size_t>(r)].component;
+  }
+  return count;
+}
+
 }  // namespace
 
 Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
@@ -93,30 +135,19 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
   const bool planes_fit = std::all_of(normals.begin(), normals.end(), [&](const cv::Mat& n) { return fits(n, CV_32F); });
   if (!fits(edges, CV_8U) || !fits(depth, CV_32F) || !planes_fit)
     throw Error("extract_patches: edges (CV_8U), depth and the normal planes (CV_32F) must be images of one size");
-  // OpenCV's labelling without its statistics: the pass below gathers them together with ours
-  // (OpenCV's own statistics pass costs more than the labelling itself).
-  cv::Mat components;
-  const int count = cv::connectedComponents(edges == 0, components, 4, CV_32S);
-  const int bins = params.histogram_bins, cols = edges.cols;
-  std::vector<ComponentSums> sums(static_cast<size_t>(count));
-  // First the runs, with each component's area and box; then the statistics, only for the components
-  // that are large enough to become patches (most components are specks along the edges). A run of
-  // non-edge pixels along a row lies in one component: the runs are read from the edge mask (a byte
-  // per pixel), the component at the run's first pixel.
   std::vector<Run> runs;
-  for (int y = 0; y < edges.rows; ++y) {
-    const uchar* edge = edges.ptr<uchar>(y);
-    for (int x = first_zero(edge, 0, cols); x < cols; x = first_zero(edge, x, cols)) {
-      const int start = x, c = components.ptr<int>(y)[x];
-      x = first_nonzero(edge, x, cols);
-      runs.push_back({c, y, start, x});
-      ComponentSums& s = sums[static_cast<size_t>(c)];
-      s.area += x - start;
-      s.x0 = std::min(s.x0, start);
-      s.x1 = std::max(s.x1, x - 1);
-      s.y0 = std::min(s.y0, y);
-      s.y1 = y;
-    }
+  const int count = label_runs(edges, runs);
+  const int bins = params.histogram_bins, cols = edges.cols;
+  // First each component's area and box; then the statistics, only for the components that are large
+  // enough to become patches (most components are specks along the edges).
+  std::vector<ComponentSums> sums(static_cast<size_t>(count));
+  for (const Run& run : runs) {
+    ComponentSums& s = sums[static_cast<size_t>(run.component)];
+    s.area += run.x1 - run.x0;
+    s.x0 = std::min(s.x0, run.x0);
+    s.x1 = std::max(s.x1, run.x1 - 1);
+    s.y0 = std::min(s.y0, run.y);
+    s.y1 = run.y;
   }
   for (ComponentSums& s : sums)
     if (s.area >= min_size) {
@@ -150,7 +181,7 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
     for (; k < n; ++k) ++counts[(k % kCounters) * cells + bin[static_cast<size_t>(k)]];
   }
 
-  // Components of at least min_size pixels become patches 1..N, in OpenCV's (raster) order.
+  // Components of at least min_size pixels become patches 1..N, in raster order.
   std::vector<int> new_id(static_cast<size_t>(count), 0);
   Patches out;
   for (int c = 1; c < count; ++c) {

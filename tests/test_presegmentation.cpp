@@ -176,6 +176,54 @@ TEST(Patches, SmallComponentsAreDropped) {
   EXPECT_THROW(extract_patches(edges, depth(cv::Rect(0, 0, 40, 30)), synth::default_camera(40, 40), nrm, {}, 10), Error);
 }
 
+TEST(Patches, AreTheFourConnectedComponentsOfTheNonEdgePixels) {
+  // Patches come from runs of non-edge pixels joined across rows. With a minimum size of 1 every
+  // component is a patch, and the patch image must be OpenCV's 4-connected labelling, numbering
+  // included (raster order of the first pixel): on random masks of every density, on a checkerboard
+  // (diagonal neighbours only: every pixel alone), on combs and spirals whose runs merge late, and on
+  // images of one row or one column.
+  const auto check = [](const cv::Mat& edges, const std::string& what) {
+    cv::Mat reference;
+    const int count = cv::connectedComponents(edges == 0, reference, 4, CV_32S);
+    const cv::Mat depth(edges.size(), CV_32F, cv::Scalar(1));
+    const NormalPlanes nrm = {cv::Mat(edges.size(), CV_32F, cv::Scalar(0)), cv::Mat(edges.size(), CV_32F, cv::Scalar(0)),
+                              cv::Mat(edges.size(), CV_32F, cv::Scalar(-1))};
+    const Patches p = extract_patches(edges, depth, synth::default_camera(edges.cols, edges.rows), nrm, {}, 1);
+    EXPECT_EQ(static_cast<int>(p.patches.size()), count - 1) << what;
+    EXPECT_EQ(cv::countNonZero(p.labels != reference), 0) << what;
+    for (const Patch& patch : p.patches)
+      EXPECT_EQ(static_cast<int>(patch.pixels.size()), cv::countNonZero(reference == patch.id)) << what;
+  };
+  cv::RNG rng(17);
+  for (const double density : {0.05, 0.3, 0.45, 0.6, 0.9}) {
+    cv::Mat noise(53, 71, CV_32F);
+    rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+    check(noise < density, "random, density " + std::to_string(density));
+  }
+  cv::Mat checkerboard(20, 24, CV_8U);
+  for (int y = 0; y < checkerboard.rows; ++y)
+    for (int x = 0; x < checkerboard.cols; ++x) checkerboard.at<uchar>(y, x) = (x + y) % 2 ? 255 : 0;
+  check(checkerboard, "checkerboard");
+  cv::Mat comb(30, 40, CV_8U, cv::Scalar(0));  // teeth hanging from a bar at the bottom
+  for (int x = 1; x < 40; x += 2) comb(cv::Rect(x, 0, 1, 29)).setTo(255);
+  check(comb, "comb");
+  cv::Mat spiral(41, 41, CV_8U, cv::Scalar(255));  // one path winding inwards
+  for (int i = 0; 2 * i < 20; ++i) {
+    const int a = 2 * i, b = 40 - 2 * i;
+    spiral.row(a).colRange(a, b + 1).setTo(0);
+    spiral.col(b).rowRange(a, b + 1).setTo(0);
+    spiral.row(b).colRange(a + 2, b + 1).setTo(0);
+    spiral.col(a + 2).rowRange(a + 2, b + 1).setTo(0);
+  }
+  check(spiral, "spiral");
+  cv::Mat row(1, 50, CV_8U), column(50, 1, CV_8U);
+  rng.fill(row, cv::RNG::UNIFORM, 0, 2);
+  rng.fill(column, cv::RNG::UNIFORM, 0, 2);
+  check(row * 255, "one row");
+  check(column * 255, "one column");
+  check(cv::Mat(9, 9, CV_8U, cv::Scalar(255)), "all edges");
+}
+
 TEST(Segmenter, RejectsBadInput) {
   Camera cam = synth::default_camera(64, 48);
   EXPECT_THROW(segment(cv::Mat(48, 64, CV_16U, cv::Scalar(0)), cam), Error);      // all invalid
