@@ -12,8 +12,9 @@ struct Patches {
   std::vector<Patch> patches;  // patches[i].id == i + 1
 };
 
-// 4-connected components of the non-edge pixels; components smaller than min_size (already scaled
-// to the resolution) are dropped. Statistics per patch from the depth (CV_32F metres; the centroid of
+// 4-connected components of the non-edge pixels (edges: CV_8U, non-zero = edge), numbered 1..N in
+// raster order of their first pixel, as cv::connectedComponents numbers them; components smaller than
+// min_size (already scaled to the resolution) are dropped. Statistics per patch from the depth (CV_32F metres; the centroid of
 // the points depth_to_points gives) and the normals.
 Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
                         const NormalPlanes& normals, const Params::Patches& params, int min_size);
