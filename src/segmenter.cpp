@@ -69,7 +69,9 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   Stopwatch watch(r.timings_ms);
   if (p.smoothing.median) depth = median_depth(depth);                           // a) 3x3 median
   watch.mark("median");
-  if (p.smoothing.temporal) depth = temporal_.push(depth, p.smoothing);          // a) temporal smoothing
+  if (p.smoothing.temporal)                                                       // a) temporal smoothing
+    depth = p.smoothing.median ? temporal_.push(std::move(depth), p.smoothing)    // the median's own buffer
+                               : temporal_.push(depth, p.smoothing);              // may be the caller's image
   watch.mark("temporal_smoothing");
   r.depth = depth;
   r.normals = compute_normals(depth, camera, step, px.odd(p.normals.smooth_ksize), jump);  // a) normals

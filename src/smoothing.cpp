@@ -239,15 +239,31 @@ void mean_within_band(const std::vector<const float*>& rows, const float* centre
 
 }  // namespace
 
-cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& params) {
-  if (!window_.empty() && window_.back().size() != depth.size()) window_.clear();
-  cv::Mat slot;  // the buffer of the frame that leaves the window takes the new one (no allocation)
+cv::Mat TemporalSmoother::make_room(const cv::Size& size, const Params::Smoothing& params) {
+  if (!window_.empty() && window_.back().size() != size) window_.clear();
+  cv::Mat slot;
   while (static_cast<int>(window_.size()) >= std::max(1, params.temporal_frames)) {
     slot = std::move(window_.front());
     window_.pop_front();
   }
+  return slot;
+}
+
+cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& params) {
+  cv::Mat slot = make_room(depth.size(), params);  // the leaving frame's buffer takes the new one (no allocation)
   depth.copyTo(slot);
   window_.push_back(slot);
+  return smooth_newest(params);
+}
+
+cv::Mat TemporalSmoother::push(cv::Mat&& depth, const Params::Smoothing& params) {
+  make_room(depth.size(), params);
+  window_.push_back(std::move(depth));
+  return smooth_newest(params);
+}
+
+cv::Mat TemporalSmoother::smooth_newest(const Params::Smoothing& params) const {
+  const cv::Mat& depth = window_.back();
   if (window_.size() == 1) return depth.clone();
 
   cv::Mat out(depth.size(), CV_32F);

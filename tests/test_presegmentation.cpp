@@ -268,6 +268,21 @@ TEST(Temporal, AnyWindowLengthIsTheTwoPassBandMean) {
   }
 }
 
+TEST(Temporal, AWindowOfCopiesAndAWindowOfAdoptedFramesAgree) {
+  // push(const&) keeps a copy: the caller may reuse its image, as a camera loop filling one buffer does.
+  // push(&&) keeps the frame's own buffer. Fed the same frames, both give the same output every frame.
+  Params::Smoothing p;
+  TemporalSmoother copies, adopted;
+  cv::RNG rng(3);
+  cv::Mat camera_buffer(9, 11, CV_32F);
+  for (int i = 0; i < 10; ++i) {
+    rng.fill(camera_buffer, cv::RNG::NORMAL, 1.0, 0.003);
+    const cv::Mat from_copies = copies.push(camera_buffer, p);
+    const cv::Mat from_adopted = adopted.push(camera_buffer.clone(), p);
+    ASSERT_EQ(cv::countNonZero(from_copies != from_adopted), 0) << "frame " << i;
+  }
+}
+
 TEST(Temporal, MovingBoxLeavesNoSmearAndStaticTableGetsQuieter) {
   // A box slides 4 cm per frame over a table; 1.5 mm of Gaussian depth noise on every frame.
   scenes::TestScene scene = scenes::box_on_plane();

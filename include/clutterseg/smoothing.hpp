@@ -20,11 +20,17 @@ cv::Mat median_depth(const cv::Mat& depth);
 // ones keep their newest depth (no motion blur). A pixel invalid in the newest frame stays invalid.
 class TemporalSmoother {
  public:
+  // Adds a copy of `depth` to the window and returns the smoothed newest frame.
   cv::Mat push(const cv::Mat& depth, const Params::Smoothing& params);
+  // The same, keeping `depth`'s buffer in the window instead of a copy: for a frame nothing else will
+  // write to (the median's output, say), one copy less.
+  cv::Mat push(cv::Mat&& depth, const Params::Smoothing& params);
   void reset() { window_.clear(); }
   int size() const { return static_cast<int>(window_.size()); }
 
  private:
+  cv::Mat make_room(const cv::Size& size, const Params::Smoothing& params);  // the buffer of the frame that leaves
+  cv::Mat smooth_newest(const Params::Smoothing& params) const;
   std::deque<cv::Mat> window_;  // newest last
 };
 
