@@ -1,5 +1,6 @@
 #include "clutterseg/normals.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
@@ -44,6 +45,97 @@ CLUTTERSEG_ROW_KERNEL void raw_normal_row(const float* __restrict up, const floa
     nx[x] = n0 * inv;
     ny[x] = n1 * inv;
     nz[x] = n2 * inv;
+  }
+}
+
+// The separable Gaussian, one row at a time: out[x] = w[0] c[x] + sum_k w[k] (a_k[x] + b_k[x]) for
+// k = 1 .. r, where a_k, b_k are the values k before and after x along the row (smooth_row) or in the
+// rows k above and below (smooth_column). Unrolled for the radii met in practice, so that each pixel sums
+// in a register (one load per tap, one store); any other radius adds tap pair by tap pair.
+template <int R>
+[[gnu::always_inline]] inline void row_taps(const float* __restrict in, const float* __restrict w, int cols,
+                                            float* __restrict out) {
+  for (int x = 0; x < cols; ++x) {
+    float sum = w[0] * in[x];
+    for (int k = 1; k <= R; ++k) sum += w[k] * (in[x - k] + in[x + k]);
+    out[x] = sum;
+  }
+}
+
+template <int R>
+[[gnu::always_inline]] inline void column_taps(const float* const* rows, const float* __restrict w, int cols,
+                                               float* __restrict out) {
+  const float* __restrict centre = rows[R];
+  const float* __restrict above[R + 1];
+  const float* __restrict below[R + 1];
+  for (int k = 1; k <= R; ++k) above[k] = rows[R - k], below[k] = rows[R + k];
+  for (int x = 0; x < cols; ++x) {
+    float sum = w[0] * centre[x];
+    for (int k = 1; k <= R; ++k) sum += w[k] * (above[k][x] + below[k][x]);
+    out[x] = sum;
+  }
+}
+
+CLUTTERSEG_ROW_KERNEL void add_tap_pair(const float* __restrict a, const float* __restrict b, float w, int cols,
+                                        float* __restrict out) {
+  for (int x = 0; x < cols; ++x) out[x] += w * (a[x] + b[x]);
+}
+
+// `in` holds r values before 0 and after cols - 1.
+CLUTTERSEG_ROW_KERNEL void smooth_row(const float* __restrict in, const float* __restrict w, int r, int cols,
+                                      float* __restrict out) {
+  switch (r) {
+    case 1: return row_taps<1>(in, w, cols, out);
+    case 2: return row_taps<2>(in, w, cols, out);
+    case 3: return row_taps<3>(in, w, cols, out);
+    case 4: return row_taps<4>(in, w, cols, out);
+    case 5: return row_taps<5>(in, w, cols, out);
+    case 6: return row_taps<6>(in, w, cols, out);
+    case 7: return row_taps<7>(in, w, cols, out);
+    case 8: return row_taps<8>(in, w, cols, out);
+    default:
+      for (int x = 0; x < cols; ++x) out[x] = w[0] * in[x];
+      for (int k = 1; k <= r; ++k) add_tap_pair(in - k, in + k, w[k], cols, out);
+  }
+}
+
+// rows[r + k] is the row k below (above for k < 0) the output row.
+CLUTTERSEG_ROW_KERNEL void smooth_column(const float* const* rows, const float* __restrict w, int r, int cols,
+                                         float* __restrict out) {
+  switch (r) {
+    case 1: return column_taps<1>(rows, w, cols, out);
+    case 2: return column_taps<2>(rows, w, cols, out);
+    case 3: return column_taps<3>(rows, w, cols, out);
+    case 4: return column_taps<4>(rows, w, cols, out);
+    case 5: return column_taps<5>(rows, w, cols, out);
+    case 6: return column_taps<6>(rows, w, cols, out);
+    case 7: return column_taps<7>(rows, w, cols, out);
+    case 8: return column_taps<8>(rows, w, cols, out);
+    default:
+      for (int x = 0; x < cols; ++x) out[x] = w[0] * rows[r][x];
+      for (int k = 1; k <= r; ++k) add_tap_pair(rows[r - k], rows[r + k], w[k], cols, out);
+  }
+}
+
+// A Gaussian of 2 r + 1 taps (weights w[0 .. r] from the centre out) over one CV_32F plane, in place,
+// the outermost values repeated beyond the border (cv::BORDER_REPLICATE). Each input row is smoothed
+// along the row into a ring of the last 2 r + 1 rows before the output row r above it is written.
+// OpenCV's GaussianBlur does the same, but at more than 5 taps its float row filter is a generic one
+// that takes twice the time of this whole function (docs/BENCHMARKS.md, "Fifth speed pass").
+void smooth_plane(cv::Mat& plane, const std::vector<float>& w) {
+  const int rows = plane.rows, cols = plane.cols, r = static_cast<int>(w.size()) - 1, taps = 2 * r + 1;
+  cv::Mat ring(taps, cols, CV_32F), padded(1, cols + 2 * r, CV_32F);  // cv::Mat rows are 64-byte aligned
+  float* const in = padded.ptr<float>() + r;
+  std::vector<const float*> window(static_cast<size_t>(taps));
+  for (int y = 0, next = 0; y < rows; ++y) {
+    for (; next <= std::min(y + r, rows - 1); ++next) {
+      std::copy_n(plane.ptr<float>(next), cols, in);
+      std::fill(in - r, in, in[0]);
+      std::fill(in + cols, in + cols + r, in[cols - 1]);
+      smooth_row(in, w.data(), r, cols, ring.ptr<float>(next % taps));
+    }
+    for (int k = -r; k <= r; ++k) window[static_cast<size_t>(k + r)] = ring.ptr<float>(std::clamp(y + k, 0, rows - 1) % taps);
+    smooth_column(window.data(), w.data(), r, cols, plane.ptr<float>(y));
   }
 }
 
@@ -106,8 +198,15 @@ NormalPlanes compute_normals(const cv::Mat& depth, const Camera& camera, int ste
                      s, jump_limit, planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
     }
   });
-  if (ksize > 1)
-    for (auto& p : planes) cv::GaussianBlur(p, p, cv::Size(ksize, ksize), 0, 0, cv::BORDER_REPLICATE);
+  if (ksize > 1) {
+    // OpenCV's Gaussian weights (its sigma for the size, as cv::GaussianBlur), from the centre out.
+    const cv::Mat kernel = cv::getGaussianKernel(ksize, 0, CV_32F);
+    std::vector<float> weights(static_cast<size_t>(ksize / 2 + 1));
+    for (size_t k = 0; k < weights.size(); ++k) weights[k] = kernel.at<float>(ksize / 2 + static_cast<int>(k));
+    parallel_for_rows(3, [&](int begin, int end) {  // the three planes, each one in place
+      for (int c = begin; c < end; ++c) smooth_plane(planes[static_cast<size_t>(c)], weights);
+    });
+  }
   parallel_for_rows(rows, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
       normalize_row(depth.ptr<float>(y), cols, planes[0].ptr<float>(y), planes[1].ptr<float>(y), planes[2].ptr<float>(y));
