@@ -81,7 +81,7 @@ CLUTTERSEG_ROW_KERNEL void add_tap_pair(const float* __restrict a, const float* 
   for (int x = 0; x < cols; ++x) out[x] += w * (a[x] + b[x]);
 }
 
-// `in` holds r values before 0 and after cols - 1.
+// `in` has r values before 0 and after cols - 1.
 CLUTTERSEG_ROW_KERNEL void smooth_row(const float* __restrict in, const float* __restrict w, int r, int cols,
                                       float* __restrict out) {
   switch (r) {
@@ -124,15 +124,25 @@ CLUTTERSEG_ROW_KERNEL void smooth_column(const float* const* rows, const float* 
 // that takes twice the time of this whole function (docs/BENCHMARKS.md, "Fifth speed pass").
 void smooth_plane(cv::Mat& plane, const std::vector<float>& w) {
   const int rows = plane.rows, cols = plane.cols, r = static_cast<int>(w.size()) - 1, taps = 2 * r + 1;
-  cv::Mat ring(taps, cols, CV_32F), padded(1, cols + 2 * r, CV_32F);  // cv::Mat rows are 64-byte aligned
-  float* const in = padded.ptr<float>() + r;
+  cv::Mat ring(taps, cols, CV_32F);  // cv::Mat rows are 64-byte aligned
   std::vector<const float*> window(static_cast<size_t>(taps));
+  // The columns within r of the left and right border, with the index clamped; the same sums in the
+  // same order as smooth_row, which takes the columns in between straight from the plane.
+  const auto border_columns = [&](const float* in, int from, int to, float* out) {
+    for (int x = from; x < to; ++x) {
+      float sum = w[0] * in[x];
+      for (int k = 1; k <= r; ++k) sum += w[static_cast<size_t>(k)] * (in[std::max(x - k, 0)] + in[std::min(x + k, cols - 1)]);
+      out[x] = sum;
+    }
+  };
+  const int inner_begin = std::min(r, cols), inner_end = std::max(cols - r, inner_begin);
   for (int y = 0, next = 0; y < rows; ++y) {
     for (; next <= std::min(y + r, rows - 1); ++next) {
-      std::copy_n(plane.ptr<float>(next), cols, in);
-      std::fill(in - r, in, in[0]);
-      std::fill(in + cols, in + cols + r, in[cols - 1]);
-      smooth_row(in, w.data(), r, cols, ring.ptr<float>(next % taps));
+      const float* in = plane.ptr<float>(next);
+      float* out = ring.ptr<float>(next % taps);
+      border_columns(in, 0, inner_begin, out);
+      smooth_row(in + inner_begin, w.data(), r, inner_end - inner_begin, out + inner_begin);
+      border_columns(in, inner_end, cols, out);
     }
     for (int k = -r; k <= r; ++k) window[static_cast<size_t>(k + r)] = ring.ptr<float>(std::clamp(y + k, 0, rows - 1) % taps);
     smooth_column(window.data(), w.data(), r, cols, plane.ptr<float>(y));
