@@ -143,8 +143,9 @@ void EdgePixelAssignment(benchmark::State& st) {
   });
 }
 
-// Only the OpenCV calls of the pre-segmentation, on the same images: the 3x3 median and the Gaussian of
-// each normal plane. The part of the pre-segmentation's time that is OpenCV's.
+// OpenCV's 3x3 median (which the median stage calls) and cv::GaussianBlur of each normal plane (which the
+// normals stage used until it smoothed with its own filter), on the same images: a fixed OpenCV workload,
+// the baseline for Median + Normals in the same run.
 void OpenCVCalls(benchmark::State& st) {
   per_stage_frame(st, [](const Stages& s, const Camera& c) {
     const int ksize = PixelScale(c.fx, c.fy).odd(kParams.normals.smooth_ksize);
