@@ -130,16 +130,16 @@ TEST(Normals, SmoothingIsOpenCVsGaussianEverywhere) {
   // The normals' Gaussian is our own separable filter (OpenCV's float row filter is slow at more than 5
   // taps). Against cv::GaussianBlur (BORDER_REPLICATE) of the unsmoothed normals, renormalised, at every
   // pixel, borders included: on a noisy surface with holes and jumps, at a width that is no multiple of
-  // the vector width, for unrolled sizes (3 to 17) and one beyond them (19), and a kernel taller than
-  // the image.
+  // the vector width, for unrolled sizes (3 to 17) and one beyond them (19), and kernels taller or
+  // wider than the image.
   cv::RNG rng(11);
-  for (const cv::Size size : {cv::Size(45, 37), cv::Size(64, 7)}) {
+  for (const cv::Size size : {cv::Size(45, 37), cv::Size(64, 7), cv::Size(5, 40), cv::Size(1, 1)}) {
     cv::Mat depth(size, CV_32F);
     rng.fill(depth, cv::RNG::UNIFORM, 0.9, 1.1);
     cv::Mat holes(size, CV_32F);
     rng.fill(holes, cv::RNG::UNIFORM, 0.0, 1.0);
     depth.setTo(0, holes < 0.1);
-    depth(cv::Rect(size.width / 2, 0, size.width / 2, size.height)) += 0.3f;  // a jump
+    if (size.width > 1) depth(cv::Rect(size.width / 2, 0, size.width / 2, size.height)) += 0.3f;  // a jump
     const Camera cam = synth::default_camera(size.width, size.height);
     const NormalPlanes raw = compute_normals(depth, cam, 1, 1, 0.05f);
     for (const int ksize : {3, 5, 9, 17, 19}) {
