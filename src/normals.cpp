@@ -48,30 +48,21 @@ CLUTTERSEG_ROW_KERNEL void raw_normal_row(const float* __restrict up, const floa
   }
 }
 
-// The separable Gaussian, one row at a time: out[x] = w[0] c[x] + sum_k w[k] (a_k[x] + b_k[x]) for
-// k = 1 .. r, where a_k, b_k are the values k before and after x along the row (smooth_row) or in the
-// rows k above and below (smooth_column). Unrolled for the radii met in practice, so that each pixel sums
-// in a register (one load per tap, one store); any other radius adds tap pair by tap pair.
+// One pass of the separable Gaussian over a row: out[x] = w[0] c[x] + sum_k w[k] (a_k[x] + b_k[x]) for
+// k = 1 .. r, where c = taps[r], a_k = taps[r - k], b_k = taps[r + k]. Down a column these are the rows
+// k above and below; along a row, the same row shifted by k. Unrolled for the radii met in practice, so
+// that each pixel sums in a register (one load per tap, one store); any other radius adds tap pair by
+// tap pair.
 template <int R>
-[[gnu::always_inline]] inline void row_taps(const float* __restrict in, const float* __restrict w, int cols,
-                                            float* __restrict out) {
-  for (int x = 0; x < cols; ++x) {
-    float sum = w[0] * in[x];
-    for (int k = 1; k <= R; ++k) sum += w[k] * (in[x - k] + in[x + k]);
-    out[x] = sum;
-  }
-}
-
-template <int R>
-[[gnu::always_inline]] inline void column_taps(const float* const* rows, const float* __restrict w, int cols,
-                                               float* __restrict out) {
-  const float* __restrict centre = rows[R];
-  const float* __restrict above[R + 1];
-  const float* __restrict below[R + 1];
-  for (int k = 1; k <= R; ++k) above[k] = rows[R - k], below[k] = rows[R + k];
+[[gnu::always_inline]] inline void unrolled_taps(const float* const* taps, const float* __restrict w, int cols,
+                                                 float* __restrict out) {
+  const float* __restrict centre = taps[R];
+  const float* __restrict before[R + 1];
+  const float* __restrict after[R + 1];
+  for (int k = 1; k <= R; ++k) before[k] = taps[R - k], after[k] = taps[R + k];
   for (int x = 0; x < cols; ++x) {
     float sum = w[0] * centre[x];
-    for (int k = 1; k <= R; ++k) sum += w[k] * (above[k][x] + below[k][x]);
+    for (int k = 1; k <= R; ++k) sum += w[k] * (before[k][x] + after[k][x]);
     out[x] = sum;
   }
 }
@@ -81,39 +72,20 @@ CLUTTERSEG_ROW_KERNEL void add_tap_pair(const float* __restrict a, const float* 
   for (int x = 0; x < cols; ++x) out[x] += w * (a[x] + b[x]);
 }
 
-// `in` has r values before 0 and after cols - 1.
-CLUTTERSEG_ROW_KERNEL void smooth_row(const float* __restrict in, const float* __restrict w, int r, int cols,
-                                      float* __restrict out) {
+CLUTTERSEG_ROW_KERNEL void smooth_taps(const float* const* taps, const float* __restrict w, int r, int cols,
+                                       float* __restrict out) {
   switch (r) {
-    case 1: return row_taps<1>(in, w, cols, out);
-    case 2: return row_taps<2>(in, w, cols, out);
-    case 3: return row_taps<3>(in, w, cols, out);
-    case 4: return row_taps<4>(in, w, cols, out);
-    case 5: return row_taps<5>(in, w, cols, out);
-    case 6: return row_taps<6>(in, w, cols, out);
-    case 7: return row_taps<7>(in, w, cols, out);
-    case 8: return row_taps<8>(in, w, cols, out);
+    case 1: return unrolled_taps<1>(taps, w, cols, out);
+    case 2: return unrolled_taps<2>(taps, w, cols, out);
+    case 3: return unrolled_taps<3>(taps, w, cols, out);
+    case 4: return unrolled_taps<4>(taps, w, cols, out);
+    case 5: return unrolled_taps<5>(taps, w, cols, out);
+    case 6: return unrolled_taps<6>(taps, w, cols, out);
+    case 7: return unrolled_taps<7>(taps, w, cols, out);
+    case 8: return unrolled_taps<8>(taps, w, cols, out);
     default:
-      for (int x = 0; x < cols; ++x) out[x] = w[0] * in[x];
-      for (int k = 1; k <= r; ++k) add_tap_pair(in - k, in + k, w[k], cols, out);
-  }
-}
-
-// rows[r + k] is the row k below (above for k < 0) the output row.
-CLUTTERSEG_ROW_KERNEL void smooth_column(const float* const* rows, const float* __restrict w, int r, int cols,
-                                         float* __restrict out) {
-  switch (r) {
-    case 1: return column_taps<1>(rows, w, cols, out);
-    case 2: return column_taps<2>(rows, w, cols, out);
-    case 3: return column_taps<3>(rows, w, cols, out);
-    case 4: return column_taps<4>(rows, w, cols, out);
-    case 5: return column_taps<5>(rows, w, cols, out);
-    case 6: return column_taps<6>(rows, w, cols, out);
-    case 7: return column_taps<7>(rows, w, cols, out);
-    case 8: return column_taps<8>(rows, w, cols, out);
-    default:
-      for (int x = 0; x < cols; ++x) out[x] = w[0] * rows[r][x];
-      for (int k = 1; k <= r; ++k) add_tap_pair(rows[r - k], rows[r + k], w[k], cols, out);
+      for (int x = 0; x < cols; ++x) out[x] = w[0] * taps[r][x];
+      for (int k = 1; k <= r; ++k) add_tap_pair(taps[r - k], taps[r + k], w[k], cols, out);
   }
 }
 
@@ -125,9 +97,9 @@ CLUTTERSEG_ROW_KERNEL void smooth_column(const float* const* rows, const float* 
 void smooth_plane(cv::Mat& plane, const std::vector<float>& w) {
   const int rows = plane.rows, cols = plane.cols, r = static_cast<int>(w.size()) - 1, taps = 2 * r + 1;
   cv::Mat ring(taps, cols, CV_32F);  // cv::Mat rows are 64-byte aligned
-  std::vector<const float*> window(static_cast<size_t>(taps));
+  std::vector<const float*> window(static_cast<size_t>(taps)), shifted(static_cast<size_t>(taps));  // the taps
   // The columns within r of the left and right border, with the index clamped; the same sums in the
-  // same order as smooth_row, which takes the columns in between straight from the plane.
+  // same order as smooth_taps, which takes the columns in between straight from the plane.
   const auto border_columns = [&](const float* in, int from, int to, float* out) {
     for (int x = from; x < to; ++x) {
       float sum = w[0] * in[x];
@@ -141,11 +113,14 @@ void smooth_plane(cv::Mat& plane, const std::vector<float>& w) {
       const float* in = plane.ptr<float>(next);
       float* out = ring.ptr<float>(next % taps);
       border_columns(in, 0, inner_begin, out);
-      smooth_row(in + inner_begin, w.data(), r, inner_end - inner_begin, out + inner_begin);
+      if (inner_end > inner_begin) {  // then inner_begin = r, and in + r + k stays inside the row
+        for (int k = -r; k <= r; ++k) shifted[static_cast<size_t>(k + r)] = in + inner_begin + k;
+        smooth_taps(shifted.data(), w.data(), r, inner_end - inner_begin, out + inner_begin);
+      }
       border_columns(in, inner_end, cols, out);
     }
     for (int k = -r; k <= r; ++k) window[static_cast<size_t>(k + r)] = ring.ptr<float>(std::clamp(y + k, 0, rows - 1) % taps);
-    smooth_column(window.data(), w.data(), r, cols, plane.ptr<float>(y));
+    smooth_taps(window.data(), w.data(), r, cols, plane.ptr<float>(y));
   }
 }
 
