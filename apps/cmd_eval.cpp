@@ -194,6 +194,7 @@ void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord&
         throw Error(frame.path.string() + ": " + e.what());
       }
       rec.scores = score_frame(frame.label, out.labels);
+      rec.errors = error_breakdown(frame.label, out.labels, rec.scores.matches);
       report.boundary_tolerance_px = boundary_tolerance_px(frame.label.size());  // one camera per set
       for (const auto& [stage, ms] : out.timings_ms) {
         auto it = std::find_if(stage_sums.begin(), stage_sums.end(), [&](const auto& s) { return s.first == stage; });

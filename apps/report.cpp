@@ -40,6 +40,18 @@ std::string cell(const GroupSummary& g, size_t metric) {
   return metric < 3 ? mean_pm_std(g.scores[metric]) : percent(g.scores[metric].mean);
 }
 
+// Headers of the error breakdown (kBreakdownNames), then the three event counts.
+constexpr std::array<const char*, kBreakdownNames.size()> kBreakdownTitles = {
+    "R: kept", "R: boundary", "R: dropped", "R: split off", "R: merged away",
+    "P: correct", "P: boundary", "P: table/bg", "P: other object", "P: extra segments"};
+constexpr std::array<const char*, 3> kEventTitles = {"merged objects", "split objects", "missed objects"};
+constexpr const char* kBreakdownLegend =
+    "R: shares of the ground-truth object pixels (kept = Overlap R); P: shares of the predicted object pixels "
+    "(correct = Overlap P); boundary = wrong but within the boundary tolerance of a ground-truth boundary; "
+    "objects: counts over the frames (docs/EVAL.md)";
+
+std::array<int, 3> events(const GroupSummary& g) { return {g.merged_objects, g.split_objects, g.missed_objects}; }
+
 std::string run_title(const RunRecord& run) { return run.label + (run.best ? " (best Overlap F)" : ""); }
 
 std::string group_note(const GroupSummary& g) {
@@ -137,7 +149,7 @@ std::vector<GroupSummary> summarize(const std::vector<FrameRecord>& frames) {
     GroupSummary g;
     g.family = family;
     // scene -> frame scores of that scene, in frame order
-    std::map<std::string, std::vector<const FrameScores*>> scenes;
+    std::map<std::string, std::vector<const FrameRecord*>> scenes;
     for (const auto& f : frames) {
       if (family != "all" && f.family != family) continue;
       if (f.failed()) {
@@ -146,19 +158,27 @@ std::vector<GroupSummary> summarize(const std::vector<FrameRecord>& frames) {
         ++g.unscored;
       } else {
         ++g.frames;
-        scenes[f.scene].push_back(&f.scores);
+        scenes[f.scene].push_back(&f);
+        g.merged_objects += f.errors.merged_objects;
+        g.split_objects += f.errors.split_objects;
+        g.missed_objects += f.errors.missed_objects;
       }
     }
     g.scenes = static_cast<int>(scenes.size());
-    for (size_t k = 0; k < kScoreNames.size(); ++k) {
+    // Per scene the mean of its frames, then mean and std over the scenes.
+    const auto over_scenes = [&](auto value_of_frame) {
       std::vector<double> scene_means;
       for (const auto& [scene, list] : scenes) {
         std::vector<double> values;
-        for (const FrameScores* s : list) values.push_back(score_values(*s)[k]);
+        for (const FrameRecord* f : list) values.push_back(value_of_frame(*f));
         scene_means.push_back(mean_std(values).mean);
       }
-      g.scores[k] = mean_std(scene_means);
-    }
+      return mean_std(scene_means);
+    };
+    for (size_t k = 0; k < kScoreNames.size(); ++k)
+      g.scores[k] = over_scenes([k](const FrameRecord& f) { return score_values(f.scores)[k]; });
+    for (size_t k = 0; k < kBreakdownNames.size(); ++k)
+      g.errors[k] = over_scenes([k](const FrameRecord& f) { return breakdown_values(f.errors)[k]; });
     groups.push_back(g);
   }
   return groups;
@@ -180,6 +200,18 @@ std::string format_tables(const EvalReport& report) {
       if (g.family == "all" && !group_note(g).empty()) notes = group_note(g);
     }
     if (!notes.empty()) out << "\n" << notes << "\n";
+    out << "\nWhere the errors are (" << kBreakdownLegend << "):\n\n| family |";
+    for (const char* t : kBreakdownTitles) out << " " << t << " |";
+    for (const char* t : kEventTitles) out << " " << t << " |";
+    out << "\n|---|";
+    for (size_t k = 0; k < kBreakdownTitles.size() + kEventTitles.size(); ++k) out << "---:|";
+    out << "\n";
+    for (const auto& g : run.groups) {
+      out << "| " << g.family << " |";
+      for (const MeanStd& e : g.errors) out << " " << percent(e.mean) << " |";
+      for (int n : events(g)) out << " " << n << " |";
+      out << "\n";
+    }
   }
   if (report.sweep_parameter) {
     out << "\n### Sweep of " << *report.sweep_parameter << " (all frames)\n\n| method | " << *report.sweep_parameter
@@ -228,6 +260,11 @@ nlohmann::json summary_json(const EvalReport& report) {
         gj["scores"][kScoreNames[k]] = {{"mean", number_or_null(g.scores[k].mean)},
                                         {"std", number_or_null(g.scores[k].std)},
                                         {"scenes", g.scores[k].count}};
+      for (size_t k = 0; k < kBreakdownNames.size(); ++k)
+        gj["errors"][kBreakdownNames[k]] = number_or_null(g.errors[k].mean);
+      gj["errors"]["merged_objects"] = g.merged_objects;
+      gj["errors"]["split_objects"] = g.split_objects;
+      gj["errors"]["missed_objects"] = g.missed_objects;
       r["groups"].push_back(gj);
     }
     r["timings_ms"] = nlohmann::json::array();
@@ -244,7 +281,8 @@ std::string scenes_csv(const EvalReport& report) {
   std::ostringstream out;
   out << "run,method,setting,family,scene,frame,gt_objects,pred_objects,matched";
   for (const char* name : kScoreNames) out << "," << name;
-  out << ",total_ms,error\n";
+  for (const char* name : kBreakdownNames) out << ",error_" << name;
+  out << ",merged_objects,split_objects,missed_objects,total_ms,error\n";
   for (const auto& run : report.runs) {
     for (const auto& f : run.frames) {
       out << csv_field(run.label) << "," << csv_field(run.method) << "," << csv_field(setting_text(run)) << ","
@@ -255,6 +293,11 @@ std::string scenes_csv(const EvalReport& report) {
         out << f.scores.gt_objects << "," << f.scores.pred_objects << "," << f.scores.matched;
       }
       for (double v : score_values(f.scores)) out << "," << (f.failed() ? "" : csv_number(v));
+      for (double v : breakdown_values(f.errors)) out << "," << (f.failed() ? "" : csv_number(v));
+      if (f.failed())
+        out << ",,,";
+      else
+        out << "," << f.errors.merged_objects << "," << f.errors.split_objects << "," << f.errors.missed_objects;
       out << "," << csv_number(f.total_ms, "%.3f") << "," << csv_field(f.error) << "\n";
     }
   }
@@ -353,6 +396,18 @@ tr.best td { background: #e6f4e6; font-weight: bold; }
     }
     h << "</table>\n";
     if (!group_note(run.all()).empty()) h << "<p class=\"note\">" << html_escape(group_note(run.all())) << "</p>\n";
+    h << "<table class=\"errors\" id=\"errors-" << index - 1 << "\"><caption>" << html_escape(run_title(run))
+      << ": where the errors are</caption>\n<tr><th>family</th>";
+    for (const char* t : kBreakdownTitles) h << "<th>" << html_escape(t) << "</th>";
+    for (const char* t : kEventTitles) h << "<th>" << html_escape(t) << "</th>";
+    h << "</tr>\n";
+    for (const auto& g : run.groups) {
+      h << "<tr><td>" << html_escape(g.family) << "</td>";
+      for (const MeanStd& e : g.errors) h << "<td>" << percent(e.mean) << "</td>";
+      for (int n : events(g)) h << "<td>" << n << "</td>";
+      h << "</tr>\n";
+    }
+    h << "</table>\n<p class=\"note\">" << html_escape(kBreakdownLegend) << ".</p>\n";
   }
   if (report.sweep_parameter) {
     const std::string p = html_escape(*report.sweep_parameter);
@@ -375,6 +430,7 @@ tr.best td { background: #e6f4e6; font-weight: bold; }
   const std::vector<std::pair<std::string, std::string>> plots = {
       {"scatter", "Per frame: paper tp against fp, like the paper's Fig. 8."},
       {"families", "Per family: paper tp and UOIS Overlap F, like the paper's Table II."},
+      {"errors", "Where the errors are: each wrong pixel with one cause (recall side: ground-truth object pixels; precision side: predicted object pixels)."},
       {"timings", "Mean time per stage, like the paper's Table III (noisy on a shared machine)."},
       {"sweep", "Scores over the swept parameter (Sec. III-C tuning)."}};
   h << "<div class=\"plots\">\n";

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "clutterseg/error_breakdown.hpp"
 #include "clutterseg/metrics.hpp"
 #include "clutterseg/params.hpp"
 
@@ -19,6 +20,7 @@ namespace fs = std::filesystem;
 struct FrameRecord {
   std::string frame, family, scene;
   FrameScores scores;
+  ErrorBreakdown errors;  // why the scores are what they are
   double total_ms = FrameScores::kNaN;
   std::string error;  // non-empty: the frame failed and has no scores
   bool failed() const { return !error.empty(); }
@@ -32,6 +34,8 @@ struct GroupSummary {
   int failed = 0;    // frames that failed
   int unscored = 0;  // frames without ground-truth objects
   std::array<MeanStd, kScoreNames.size()> scores;
+  std::array<MeanStd, kBreakdownNames.size()> errors;  // averaged like the scores
+  int merged_objects = 0, split_objects = 0, missed_objects = 0;  // summed over the frames
 };
 
 // A thumbnail row of the report: one frame's images (JPEG bytes).

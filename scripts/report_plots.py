@@ -130,6 +130,40 @@ def families(summary, path):
     plt.close(fig)
 
 
+RECALL_PARTS = (("boundary", "boundary"), ("dropped", "dropped"), ("split", "split off"), ("merged", "merged away"))
+PRECISION_PARTS = (("boundary_p", "boundary"), ("background", "table/background"), ("merged_p", "other object"),
+                   ("extra", "extra segments"))
+
+
+def errors(summary, path):
+    """Where the errors are, per family and method: the lost shares of recall and of precision, stacked."""
+    bars = []  # (label, group errors)
+    for run in shown_runs(summary):
+        for g in run["groups"]:
+            if g.get("errors") and g["errors"].get("kept") is not None:
+                name = g["family"] if len(shown_runs(summary)) == 1 else f"{run['label']} / {g['family']}"
+                bars.append((name, g["errors"]))
+    if not bars:
+        return False
+    fig, axes = plt.subplots(1, 2, figsize=(9.6, 0.8 + 0.32 * len(bars)), sharey=True)
+    ys = range(len(bars))
+    for ax, parts, title in ((axes[0], RECALL_PARTS, "recall lost [% of ground-truth object pixels]"),
+                             (axes[1], PRECISION_PARTS, "precision lost [% of predicted object pixels]")):
+        left = [0.0] * len(bars)
+        for k, (key, label) in enumerate(parts):
+            widths = [100 * (e.get(key) or 0.0) for _, e in bars]
+            ax.barh(ys, widths, left=left, color=f"C{k}", label=label, height=0.7)
+            left = [a + b for a, b in zip(left, widths)]
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=7, loc="lower right")
+    axes[0].set_yticks(list(ys), [name for name, _ in bars])
+    axes[0].invert_yaxis()
+    fig.tight_layout()
+    fig.savefig(path, bbox_inches="tight")
+    plt.close(fig)
+    return True
+
+
 def sweep(summary, path):
     """Scores over the swept parameter values; the best by Overlap F is marked."""
     info = summary.get("sweep")
@@ -175,6 +209,7 @@ def main():
     scatter(summary, rows, os.path.join(plots, "scatter.svg"))
     families(summary, os.path.join(plots, "families.svg"))
     timings(summary, os.path.join(plots, "timings.svg"))
+    errors(summary, os.path.join(plots, "errors.svg"))
     sweep(summary, os.path.join(plots, "sweep.svg"))
     return 0
 

@@ -11,4 +11,4 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   libgtest-dev libgmock-dev libbenchmark-dev \
   libpcl-dev \
   chromium fonts-dejavu-core \
-  python3 python3-numpy python3-matplotlib >/dev/null
+  python3 python3-numpy python3-matplotlib python3-opencv >/dev/null

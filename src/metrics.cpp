@@ -212,6 +212,7 @@ FrameScores score_frame(const cv::Mat& ground_truth, const cv::Mat& prediction) 
   for (int i = 0; i < n; ++i) {
     if (match[i] < 0 || pair_f[i][match[i]] <= 0) continue;
     ++s.matched;
+    s.matches.emplace_back(g.ids[i], p.ids[match[i]]);
     matched_pixels += intersection[i][match[i]];
     if (pair_f[i][match[i]] > 0.75) ++detected;
   }

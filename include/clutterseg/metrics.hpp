@@ -6,6 +6,7 @@
 #include <array>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "clutterseg/types.hpp"
@@ -30,6 +31,7 @@ struct FrameScores {
   double overlap_p = kNaN, overlap_r = kNaN, overlap_f = kNaN;
   double boundary_p = kNaN, boundary_r = kNaN, boundary_f = kNaN;
   double detected_75 = kNaN;  // share of ground-truth objects whose matched F > 0.75 ("%>=75")
+  std::vector<std::pair<int, int>> matches;  // the UOIS matching: (ground-truth id, predicted id), F > 0
 
   bool scored() const { return gt_objects > 0; }
 };
