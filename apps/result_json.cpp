@@ -25,7 +25,8 @@ nlohmann::json result_to_json(const Result& r, const std::string& name) {
                             {"occupied_bins", p.occupied_bins}});
   j["graph"] = nlohmann::json::array();
   for (const auto& e : r.graph)
-    j["graph"].push_back({{"a", e.a + 1}, {"b", e.b + 1}, {"cue", to_string(e.cue)}, {"weight", e.weight}});
+    j["graph"].push_back({{"a", e.a + 1}, {"b", e.b + 1}, {"cue", to_string(e.cue)}, {"weight", e.weight},
+                          {"convexity", finite_or_null(e.convexity)}});
   j["objects"] = nlohmann::json::array();
   for (const auto& o : r.objects) {
     std::vector<int> patch_ids;

@@ -180,18 +180,26 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     int near[kMaxSeeds], count = 0, best = -1;
     for (int s = 0; s < own.count; ++s) {
       if (own.seed[s].d2 >= d2_max) continue;
-      near[count++] = own.seed[s].label;
+      near[count++] = s;
       if (best < 0 || own.seed[s].d2 < own.seed[best].d2 ||
           (own.seed[s].d2 == own.seed[best].d2 && own.seed[s].label < own.seed[best].label)) best = s;
     }
     if (best < 0) continue;
     assigned[i] = own.seed[best].label;
     for (int a = 0; a < count; ++a)
-      for (int b = a + 1; b < count; ++b)
-        out.adjacent.emplace_back(std::min(near[a], near[b]) - 1, std::max(near[a], near[b]) - 1);
+      for (int b = a + 1; b < count; ++b) {
+        const Seed* sa = &own.seed[near[a]];
+        const Seed* sb = &own.seed[near[b]];
+        if (sa->label > sb->label) std::swap(sa, sb);
+        const auto pixel = [width](const Seed& s) { return static_cast<int>(s.yx >> 16) * width + static_cast<int>(s.yx & 0xffff); };
+        out.contacts.push_back({sa->label - 1, sb->label - 1, pixel(*sa), pixel(*sb)});
+      }
   }
-  std::sort(out.adjacent.begin(), out.adjacent.end());
-  out.adjacent.erase(std::unique(out.adjacent.begin(), out.adjacent.end()), out.adjacent.end());
+  // Carriers come in raster order, so a stable sort by pair keeps each pair's contacts in raster order.
+  std::stable_sort(out.contacts.begin(), out.contacts.end(),
+                   [](const Contact& x, const Contact& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  for (const Contact& c : out.contacts)
+    if (out.adjacent.empty() || out.adjacent.back() != PatchPair(c.a, c.b)) out.adjacent.emplace_back(c.a, c.b);
   return out;
 }
 

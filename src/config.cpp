@@ -14,13 +14,14 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Edges, theta, step_px, j
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Patches, min_size_px, histogram_bins, occupied_share, flat_max_bins)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Adjacency, radius_px, d_max)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::CutFree, enabled, planes, band, wrong_side_fraction, skip_angle_deg, skip_similar)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Convexity, enabled, tolerance, concave_weight)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Coplanarity, enabled, angle_deg, triples, lines, behind_fraction, behind_tolerance, lines_pass, max_gap)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Curvature, enabled, theta_h, open_objects, occluded, line_fit, neighbour_gap_px)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::GraphCut, theta_c)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Remaining, grow_distance, tiny_px)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Support, objects_only, plane_band, max_height, contact_distance, region_margin, wall_min_extent)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Support, enabled, objects_only, plane_band, pixel_band, table_angle_deg, max_height, contact_distance, region_margin, wall_min_extent)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params, smoothing, normals, edges, patches, adjacency, cutfree,
-                                                coplanarity, curvature, graph, remaining, support, seed, threads,
+                                                convexity, coplanarity, curvature, graph, remaining, support, seed, threads,
                                                 keep_freed_memory)
 
 namespace {

@@ -97,6 +97,7 @@ cv::Mat render_graph(const Result& result, const Camera& camera) {
       case Cue::Coplanar: colour = cv::Scalar(0, 255, 0); break;
       case Cue::CurvatureOpen: colour = cv::Scalar(255, 128, 0); break;
       case Cue::CurvatureOccluded: colour = cv::Scalar(0, 200, 255); break;
+      case Cue::AdjacentConcave: colour = cv::Scalar(0, 0, 255); break;
     }
     cv::line(img, centre(e.a), centre(e.b), colour, 1 + static_cast<int>(e.weight * 4), cv::LINE_AA);
   }

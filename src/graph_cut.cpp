@@ -165,7 +165,7 @@ DenseCut minimum_cut(std::vector<float>& w, int k, double stop_below) {
 
 }  // namespace
 
-std::vector<GraphEdge> weight_graph(int num_nodes, std::vector<GraphEdge> links) {
+std::vector<GraphEdge> weight_graph(int num_nodes, std::vector<GraphEdge> links, double concave_weight) {
   for (auto& e : links) {
     if (e.a > e.b) std::swap(e.a, e.b);
     if (e.a < 0 || e.b >= num_nodes || e.a == e.b)
@@ -183,7 +183,8 @@ std::vector<GraphEdge> weight_graph(int num_nodes, std::vector<GraphEdge> links)
   for (const auto& e : links) { ++degree[static_cast<size_t>(e.a)]; ++degree[static_cast<size_t>(e.b)]; }
   // w_ij = 1/deg(i) out of i, 1/deg(j) out of j; W_sym = (W + W^T)/2 (paper i).
   for (auto& e : links)
-    e.weight = static_cast<float>(0.5 * (1.0 / degree[static_cast<size_t>(e.a)] + 1.0 / degree[static_cast<size_t>(e.b)]));
+    e.weight = static_cast<float>(0.5 * (1.0 / degree[static_cast<size_t>(e.a)] + 1.0 / degree[static_cast<size_t>(e.b)]) *
+                                  (e.cue == Cue::AdjacentConcave ? concave_weight : 1.0));
   return links;
 }
 

@@ -11,7 +11,14 @@
 // - "Enclosed" = the segment does not touch the image border or another remaining segment, and the
 //   face holds at least half of its ring of neighbour pixels; the rest may be invalid pixels (the
 //   shadow a Kinect casts beside every small object must not make it part of the table).
-// - Rule 5 is decided per pixel, not per segment: the remaining pixels between two objects are mostly
+// - Beyond the paper: a segment grows across single pixels without depth (a Kinect drops pixels all over
+//   a face seen at a grazing angle, which would leave it in specks, each "tiny" and "without a face").
+// - Beyond the paper: in rule 5 a segment that is a face of its own (its mean normal more than 30 deg from
+//   every neighbouring face's local plane: the narrow side of a box seen edge-on) joins, whole, the face it
+//   meets in a convex edge (n_s - n_f) . (c_s - c_f) > 0, as faces of one object meet, not the table or
+//   the object it stands against (a concave crease).
+// - Beyond the paper: a table face (TableHint) takes no pixel standing clear of the table's plane.
+// - Rule 5 is otherwise decided per pixel, not per segment: the remaining pixels between two objects are mostly
 //   a bold edge band that belongs half to each, and boundaries decide the metrics. The plane of each
 //   neighbouring face is a least-squares fit to that face's pixels near the segment (local, so a
 //   curved face is modelled by its tangent plane where it touches the segment); least squares on all
@@ -26,6 +33,7 @@
 #include <span>
 
 #include "clutterseg/parallel.hpp"
+#include "clutterseg/support.hpp"
 
 namespace clutterseg {
 
@@ -69,11 +77,16 @@ CLUTTERSEG_ROW_KERNEL int mark_remaining(const int* __restrict lab, const float*
 
 constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
 constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+// A face's normals and a segment's differ by more than this when the segment is a face of its own.
+const float kOwnFaceCos = static_cast<float>(std::cos(30.0 * M_PI / 180.0));
+// Convexity (contact.hpp) above which a face of its own joins a neighbouring face.
+constexpr float kConvex = 0.1f;
 
 // Least-squares plane of the pixels labelled `patch` in `window` (visited with a stride so that at most
 // about kMaxVisits pixels are read). Returns false when they are too few or collinear.
 constexpr int kMaxVisits = 4000;
-bool fit_local_plane(const cv::Mat& labels, const cv::Mat& points, int patch, cv::Rect window, Plane& plane) {
+bool fit_local_plane(const cv::Mat& labels, const cv::Mat& points, int patch, cv::Rect window, Plane& plane,
+                     Eigen::Vector3f& centroid) {
   const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
@@ -98,16 +111,18 @@ bool fit_local_plane(const cv::Mat& labels, const cv::Mat& points, int patch, cv
   if (normal.dot(mean) > 0) normal = -normal;  // facing the camera
   plane.normal = normal.cast<float>();
   plane.offset = static_cast<float>(-normal.dot(mean));
+  centroid = mean.cast<float>();
   return true;
 }
 
 // Plane of `patch` near `bbox`: the window grows until the fit is possible (bounded: whole image).
-bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, const cv::Rect& bbox, Plane& plane) {
+bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, const cv::Rect& bbox, Plane& plane,
+                    Eigen::Vector3f& centroid) {
   const cv::Rect image(0, 0, labels.cols, labels.rows);
   int margin = std::max(8, std::max(bbox.width, bbox.height) / 2);
   for (int attempt = 0; attempt < 8; ++attempt, margin *= 2) {
     const cv::Rect window = cv::Rect(bbox.x - margin, bbox.y - margin, bbox.width + 2 * margin, bbox.height + 2 * margin) & image;
-    if (fit_local_plane(labels, points, patch, window, plane)) return true;
+    if (fit_local_plane(labels, points, patch, window, plane, centroid)) return true;
     if (window == image) break;
   }
   return false;
@@ -116,11 +131,16 @@ bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, con
 }  // namespace
 
 cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
-                         int num_objects, const cv::Mat& points, const Params::Remaining& params,
-                         int tiny_px, std::uint64_t seed) {
-  (void)seed;  // least-squares planes: nothing random (see above)
+                         int num_objects, const cv::Mat& points, const NormalPlanes& normals,
+                         const Params::Remaining& params, int tiny_px, const std::optional<TableHint>& table) {
   if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || assigned_labels.size() != points.size())
     throw Error("assign_remaining: labels must be CV_32S and points CV_32FC3 of the same size");
+  const bool have_normals = !normals[0].empty();
+  if (have_normals && (normals[0].size() != points.size() || normals[1].size() != points.size() ||
+                       normals[2].size() != points.size()))
+    throw Error("assign_remaining: normals must have the size of the points");
+  if (table && table->table_patch.size() != object_of_patch.size())
+    throw Error("assign_remaining: the table hint must have one flag per patch");
   const int width = assigned_labels.cols, height = assigned_labels.rows;
   const int total = width * height;
   const int* lab = assigned_labels.ptr<int>();
@@ -156,13 +176,15 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const int i = pixels[head];
       const int x = i % width, y = i / width;
       x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
-      for (int k = 0; k < 8; ++k) {
-        const int xx = x + kDx[k], yy = y + kDy[k];
+      for (int k = 0; k < 16; ++k) {
+        // The 8 neighbours, then the pixels two steps away across a neighbour without depth.
+        const int step = k < 8 ? 1 : 2, xx = x + step * kDx[k % 8], yy = y + step * kDy[k % 8];
         if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
+        if (step == 2 && valid_point(pts[(y + kDy[k % 8]) * width + x + kDx[k % 8]])) continue;
         const int j = yy * width + xx;
         if (state[static_cast<size_t>(j)] != kRemaining) continue;
         const cv::Vec3f d = pts[i] - pts[j];
-        if (d.dot(d) >= grow2) continue;
+        if (d.dot(d) >= grow2 * static_cast<float>(step * step)) continue;
         state[static_cast<size_t>(j)] = kGrown;
         pixels.push_back(j);
       }
@@ -173,7 +195,18 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   int next_object = num_objects;
   std::vector<int> ring;                      // per segment: its ring pixels
   std::vector<std::pair<int, int>> faces;     // per segment: (patch label, ring pixels)
-  std::vector<std::pair<Plane, int>> planes;  // per segment in rule 5: plane, object id
+  struct FacePlane {
+    Plane plane;
+    Eigen::Vector3f centroid;
+    int object_id;
+    bool table;
+  };
+  std::vector<FacePlane> planes;  // per segment in rule 5
+  const auto is_table = [&](int patch_label) { return table && table->table_patch[static_cast<size_t>(patch_label - 1)]; };
+  // A point standing clear of the table's plane: no table face takes it.
+  const auto clear_of_table = [&](const cv::Vec3f& q) {
+    return table && table->plane.distance({q[0], q[1], q[2]}) > plane_tolerance(table->pixel_band, q[2]);
+  };
   for (size_t s = 0; s < segments.size(); ++s) {
     const Segment& seg = segments[s];
     const std::span<const int> seg_pixels(pixels.data() + seg.begin, seg.end - seg.begin);
@@ -206,6 +239,13 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     for (int i : seg_pixels) state[static_cast<size_t>(i)] = kGrown;
     for (int j : ring) state[static_cast<size_t>(j)] &= static_cast<uchar>(~kInRing);
     std::sort(faces.begin(), faces.end());  // by label: independent of the scan order
+    if (table && std::any_of(faces.begin(), faces.end(), [&](const auto& f) { return is_table(f.first); })) {
+      // A segment mostly clear of the table is not the table's, whatever else it touches.
+      int clear = 0;
+      for (int i : seg_pixels) clear += clear_of_table(pts[i]);
+      if (2 * clear > static_cast<int>(seg_pixels.size()))
+        std::erase_if(faces, [&](const auto& f) { return is_table(f.first); });
+    }
     auto set_all = [&](int object_id) { for (int i : seg_pixels) obj[i] = object_id; };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
 
@@ -225,23 +265,58 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       set_all(first_object);                                          // rule 4
       continue;
     }
-    // Rule 5: per pixel, the neighbouring face whose local plane fits best.
+    // Rule 5: the local plane of every neighbouring face.
     planes.clear();
     for (const auto& f : faces) {
       Plane plane;
-      if (fit_plane_near(assigned_labels, points, f.first, seg.bbox, plane)) planes.emplace_back(plane, object_of(f.first));
+      Eigen::Vector3f centroid;
+      if (fit_plane_near(assigned_labels, points, f.first, seg.bbox, plane, centroid))
+        planes.push_back({plane, centroid, object_of(f.first), is_table(f.first)});
     }
     if (planes.empty()) {  // only degenerate faces: the face with the longest contact takes it
       const auto best = std::max_element(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
       set_all(object_of(best->first));
       continue;
     }
+    // A face of its own joins the face it meets in the most convex edge.
+    if (have_normals) {
+      Eigen::Vector3f normal = Eigen::Vector3f::Zero(), centroid = Eigen::Vector3f::Zero();
+      int n = 0;
+      for (int i : seg_pixels) {
+        const Eigen::Vector3f ni(normals[0].ptr<float>()[i], normals[1].ptr<float>()[i], normals[2].ptr<float>()[i]);
+        if (ni.squaredNorm() < 0.5f) continue;  // no normal here
+        normal += ni;
+        centroid += Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
+        ++n;
+      }
+      if (n >= 3 && normal.norm() > 0.5f * static_cast<float>(n)) {  // normals that agree enough to average
+        normal.normalize();
+        centroid /= static_cast<float>(n);
+        const bool own_face = std::all_of(planes.begin(), planes.end(), [&](const FacePlane& f) {
+          return std::abs(normal.dot(f.plane.normal)) < kOwnFaceCos;
+        });
+        const FacePlane* best = nullptr;
+        float best_convexity = kConvex;
+        for (const FacePlane& f : planes) {
+          const Eigen::Vector3f d = centroid - f.centroid;
+          if (!own_face || f.table || !(d.norm() > 1e-4f)) continue;
+          const float convexity = (normal - f.plane.normal).dot(d) / d.norm();
+          if (convexity > best_convexity) { best_convexity = convexity; best = &f; }
+        }
+        if (best) {
+          set_all(best->object_id);
+          continue;
+        }
+      }
+    }
+    // Per pixel, the neighbouring face whose local plane fits best (no table face for a pixel clear of it).
     for (int i : seg_pixels) {
       const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
+      const bool clear = clear_of_table(pts[i]);
       float best = std::numeric_limits<float>::infinity();
-      for (const auto& [plane, object_id] : planes) {
-        const float d = std::abs(plane.distance(q));
-        if (d < best) { best = d; obj[i] = object_id; }
+      for (const FacePlane& f : planes) {
+        const float d = std::abs(f.plane.distance(q));
+        if (d < best && !(clear && f.table)) { best = d; obj[i] = f.object_id; }
       }
     }
   }

@@ -1,6 +1,7 @@
 #include "clutterseg/segmenter.hpp"
 
 #include "clutterseg/adjacency.hpp"
+#include "clutterseg/contact.hpp"
 #include "clutterseg/coplanarity.hpp"
 #include "clutterseg/curvature.hpp"
 #include "clutterseg/cutfree.hpp"
@@ -11,6 +12,7 @@
 #include "clutterseg/parallel.hpp"
 #include "clutterseg/remaining.hpp"
 #include "clutterseg/stopwatch.hpp"
+#include "clutterseg/support.hpp"
 
 #include <mutex>
 #if defined(__GLIBC__)
@@ -21,14 +23,32 @@ namespace clutterseg {
 
 namespace {
 
-// The patch graph of paper i): every link with its cue, weighted 1/deg and symmetrised.
-std::vector<GraphEdge> patch_graph(int num_patches, const std::vector<PatchPair>& adjacent,
-                                   const std::vector<PatchPair>& coplanar, const std::vector<CurvatureLink>& curved) {
+// The patch graph of paper i): every link with its cue, weighted 1/deg and symmetrised; adjacent pairs
+// that meet in a concave crease are weighted down (beyond the paper, Params::Convexity).
+std::vector<GraphEdge> patch_graph(const std::vector<Patch>& patches, const std::vector<PatchPair>& adjacent,
+                                   const std::vector<PairJunction>& junctions, const std::vector<PatchPair>& coplanar,
+                                   const std::vector<CurvatureLink>& curved, const Params::Convexity& convexity) {
   std::vector<GraphEdge> links;
-  for (const auto& [a, b] : adjacent) links.push_back({a, b, Cue::Adjacent, 0});
+  for (const auto& [a, b] : adjacent) {
+    const auto j = std::lower_bound(junctions.begin(), junctions.end(), PatchPair(a, b),
+                                    [](const PairJunction& x, const PatchPair& p) { return x.pair < p; });
+    const bool concave = j != junctions.end() && j->pair == PatchPair(a, b) && j->kind == Junction::Concave;
+    links.push_back({a, b, concave ? Cue::AdjacentConcave : Cue::Adjacent, 0,
+                     j != junctions.end() && j->pair == PatchPair(a, b) ? j->convexity : std::numeric_limits<float>::quiet_NaN()});
+  }
   for (const auto& [a, b] : coplanar) links.push_back({a, b, Cue::Coplanar, 0});
-  for (const auto& c : curved) links.push_back({c.pair.first, c.pair.second, c.cue, 0});
-  return weight_graph(num_patches, std::move(links));
+  for (const auto& c : curved)
+    if (patches[static_cast<size_t>(c.pair.first)].table == patches[static_cast<size_t>(c.pair.second)].table)
+      links.push_back({c.pair.first, c.pair.second, c.cue, 0});
+  return weight_graph(static_cast<int>(patches.size()), std::move(links), convexity.enabled ? convexity.concave_weight : 1.0);
+}
+
+// Pairs of which exactly one patch is table: the table never joins an object (beyond the paper).
+std::vector<PatchPair> without_table_links(std::vector<PatchPair> pairs, const std::vector<Patch>& patches) {
+  std::erase_if(pairs, [&](const PatchPair& pair) {
+    return patches[static_cast<size_t>(pair.first)].table != patches[static_cast<size_t>(pair.second)].table;
+  });
+  return pairs;
 }
 
 cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
@@ -86,33 +106,56 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   watch.mark("patches");
   r.points = depth_to_points(depth, camera);                                     // point cloud, for d) to j)
   watch.mark("pointcloud");
+  const std::optional<Plane> table = p.support.enabled                           // the table (beyond the paper)
+      ? find_support_plane(r.patches, r.points, camera, p.support) : std::nullopt;
+  if (table && cut_off_table(r.edges, r.patches, r.core_patch_labels, r.points, *table, p.support,
+                             px.area(p.patches.min_size_px)) > 0) {              // objects the edges left in it
+    patches = extract_patches(r.edges, r.depth, camera, r.normals, p.patches, px.area(p.patches.min_size_px));
+    r.core_patch_labels = patches.labels;
+    r.patches = std::move(patches.patches);
+  }
+  if (table)
+    for (Patch& patch : r.patches) patch.table = lies_in(patch, r.points, *table, p.support);
+  watch.mark("support");
   const int num_patches = static_cast<int>(r.patches.size());
-  const Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency
-                                                   px.length(p.adjacency.radius_px), p.adjacency.d_max);
+  Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency
+                                             px.length(p.adjacency.radius_px), p.adjacency.d_max);
+  if (table) release_from_table(assignment.labels, r.core_patch_labels, r.patches, r.points, *table, p.support);
   r.patch_labels = assignment.labels;
+  const std::vector<PatchPair> adjacent = without_table_links(assignment.adjacent, r.patches);
   watch.mark("assignment");
   const std::vector<PatchPair> links = p.cutfree.enabled                                  // e) cut-free
-      ? cut_free_pairs(assignment.adjacent, r.patches, r.points, p.cutfree, p.seed) : assignment.adjacent;
+      ? cut_free_pairs(adjacent, r.patches, r.points, p.cutfree, p.seed) : adjacent;
   watch.mark("cutfree");
+  const std::vector<PairJunction> junctions = p.convexity.enabled                         // convex or concave
+      ? classify_junctions(assignment.contacts, r.points, r.normals, p.convexity) : std::vector<PairJunction>{};
+  watch.mark("convexity");
   std::vector<PatchPair> linked = links;
   const std::vector<PatchPair> coplanar = p.coplanarity.enabled                         // f/g) co-planarity
-      ? coplanar_pairs(r.patches, linked, r.points, camera, p.coplanarity, p.seed) : std::vector<PatchPair>{};
+      ? without_table_links(coplanar_pairs(r.patches, linked, r.points, camera, p.coplanarity, p.seed), r.patches)
+      : std::vector<PatchPair>{};
   linked.insert(linked.end(), coplanar.begin(), coplanar.end());
   watch.mark("coplanarity");
   const std::vector<CurvatureLink> curved = p.curvature.enabled                          // h) curvature
       ? curvature_links(r.patches, linked, r.patch_labels, r.points, r.normals, camera, p) : std::vector<CurvatureLink>{};
   watch.mark("curvature");
-  r.graph = patch_graph(num_patches, links, coplanar, curved);                           // i) graph cut
+  r.graph = patch_graph(r.patches, links, junctions, coplanar, curved, p.convexity);                           // i) graph cut
   const Partition parts = cut_graph(num_patches, r.graph, p.graph.theta_c);
   watch.mark("graph_cut");
+  std::optional<TableHint> table_hint;
+  if (table) {
+    table_hint = TableHint{*table, {}, p.support.pixel_band};
+    for (const Patch& patch : r.patches) table_hint->table_patch.push_back(patch.table);
+  }
   r.object_labels = assign_remaining(r.patch_labels, parts.object_of_node,                       // j) remaining
-                                     static_cast<int>(parts.cut_cost.size()), r.points, p.remaining,
-                                     px.area(p.remaining.tiny_px), p.seed);
+                                     static_cast<int>(parts.cut_cost.size()), r.points, r.normals, p.remaining,
+                                     px.area(p.remaining.tiny_px), table_hint);
   watch.mark("remaining");
   r.objects = describe_objects(r.object_labels, r.points, parts.object_of_node, parts.cut_cost, camera);  // objects
-  r.support_plane = find_support(r.objects, r.patches, r.object_labels, r.points, p.support);   // table, walls
-  if (r.support_plane)                                                           // objects merged into it
-    split_support(r.object_labels, r.objects, *r.support_plane, r.points, p.support, px.area(p.patches.min_size_px), camera);
+  r.support_plane = table;
+  if (table)                                                                     // table, walls
+    classify_objects(r.objects, r.patches, r.object_labels, r.points, support_of(*table, r.patches, r.points, p.support),
+                     p.support);
   watch.mark("objects");
   watch.total();
   return r;

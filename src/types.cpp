@@ -22,6 +22,7 @@ const char* to_string(Cue cue) {
     case Cue::Coplanar: return "coplanar";
     case Cue::CurvatureOpen: return "curvature-open";
     case Cue::CurvatureOccluded: return "curvature-occluded";
+    case Cue::AdjacentConcave: return "adjacent-concave";
   }
   return "unknown";
 }

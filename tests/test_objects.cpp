@@ -3,6 +3,8 @@
 
 #include "clutterseg/normals.hpp"
 #include "clutterseg/objects.hpp"
+#include "clutterseg/patches.hpp"
+#include "clutterseg/support.hpp"
 #include "clutterseg/segmenter.hpp"
 #include "scene_patches.hpp"
 #include "scenes.hpp"
@@ -101,22 +103,32 @@ TEST(Objects, StackedBoxesStaySeparateAndSameInputGivesSameLabels) {
   EXPECT_NE(majority(1), majority(0));
 }
 
-TEST(Objects, ObjectMergedIntoTheTableIsSplitOff) {
-  // As if the edges had not separated box and table: one object, the support.
+TEST(Objects, ObjectTheEdgesLeftInTheTableIsCutOff) {
+  // As if the edges had not separated box and table: one patch of every pixel with depth.
   const auto scene = scenes::box_on_plane();
   const auto truth = scene.render();
   const Result r = run(scene, truth);
   ASSERT_TRUE(r.support_plane.has_value());
-  cv::Mat labels(r.object_labels.size(), CV_32S, cv::Scalar(0));
-  labels.setTo(1, truth.depth > 0);
-  std::vector<Object> objects = describe_objects(labels, r.points, {}, {}, scene.camera);
-  objects[0].support = true;
-  EXPECT_EQ(split_support(labels, objects, *r.support_plane, r.points, Params::Support{}, 50, scene.camera), 1);
-  ASSERT_EQ(objects.size(), 2u);
-  EXPECT_FALSE(objects[1].support || objects[1].background);
-  const cv::Mat view = objects_only(labels, objects);
-  EXPECT_GT(scenes::kept_share(view, truth.labels, 1, truth.depth), 0.8);  // the box but its bottom 15 mm
-  EXPECT_LT(scenes::kept_share(view, truth.labels, 0, truth.depth), 0.01);
+  cv::Mat edges(truth.depth.size(), CV_8U, cv::Scalar(0));
+  edges.setTo(255, truth.depth <= 0);
+  const Params p;
+  const Patches one = extract_patches(edges, r.depth, scene.camera, r.normals, p.patches, 50);
+  ASSERT_EQ(one.patches.size(), 1u);
+  const auto plane = find_support_plane(one.patches, r.points, scene.camera, p.support);
+  ASSERT_TRUE(plane.has_value());
+  EXPECT_GT(plane->normal.dot(r.support_plane->normal), 0.999f);  // the table's plane, not a compromise
+  ASSERT_GT(cut_off_table(edges, one.patches, one.labels, r.points, *plane, p.support, 50), 0);
+  const Patches two = extract_patches(edges, r.depth, scene.camera, r.normals, p.patches, 50);
+  ASSERT_GE(two.patches.size(), 2u);
+  // The box is now patches of its own, off the table; the table patch lies in the plane.
+  int box_pixels = 0, table_patches = 0;
+  for (const Patch& patch : two.patches) {
+    const bool table = lies_in(patch, r.points, *plane, p.support);
+    table_patches += table;
+    for (int i : patch.pixels) box_pixels += !table && truth.labels.ptr<int>()[i] == 1;
+  }
+  EXPECT_EQ(table_patches, 1);
+  EXPECT_GT(box_pixels, 0.8 * cv::countNonZero(truth.labels == 1));
 }
 
 TEST(Objects, SameLabelsForAnyThreadCount) {

@@ -22,7 +22,7 @@ struct Case {
     return depth_to_points(depth, c);
   }
   cv::Mat run(const std::vector<int>& object_of_patch, int num_objects, int tiny = 20) const {
-    return assign_remaining(labels, object_of_patch, num_objects, points(), Params::Remaining{}, tiny, 1);
+    return assign_remaining(labels, object_of_patch, num_objects, points(), NormalPlanes{}, Params::Remaining{}, tiny);
   }
 };
 

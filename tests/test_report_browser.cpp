@@ -69,14 +69,16 @@ TEST(ReportBrowser, ChromiumShowsTablesPlotsAndPictures) {
   EXPECT_NE(dom.find("<caption>clutterseg theta_c=0.4"), std::string::npos);
   for (const char* text : {"<th>tp</th>", "<th>Overlap F</th>", "<th>Boundary F</th>", "<th>%&gt;=75</th>",
                            "<td>all</td><td>3</td><td>2</td>", "<td>video 0000</td><td>2</td><td>1</td>",
-                           "<td>video 0003</td><td>1</td><td>1</td>", "id=\"sweep-table\"", "class=\"best\""})
+                           "<td>video 0003</td><td>1</td><td>1</td>", "id=\"sweep-table\"", "class=\"best\"",
+                           "<table class=\"errors\" id=\"errors-0\">", "<th>R: merged away</th>", "<th>P: table/bg</th>"})
     EXPECT_NE(dom.find(text), std::string::npos) << text;
   // The matplotlib plots and the per-frame pictures, all decoded by the browser.
-  for (const char* id : {"plot-scatter", "plot-families", "plot-timings", "plot-sweep", "frame-000001", "frame-000138"})
+  for (const char* id : {"plot-scatter", "plot-families", "plot-errors", "plot-timings", "plot-sweep", "frame-000001",
+                         "frame-000138"})
     EXPECT_NE(dom.find(std::string("id=\"") + id + "\""), std::string::npos) << id;
   EXPECT_EQ(dom.find("id=\"plot-note\""), std::string::npos) << "plots were not drawn";
-  // 4 plots + 3 frames x (image, ground truth, prediction of the best theta_c).
-  EXPECT_NE(dom.find("data-images-decoded=\"13/13\""), std::string::npos);
+  // 5 plots + 3 frames x (image, ground truth, prediction of the best theta_c).
+  EXPECT_NE(dom.find("data-images-decoded=\"14/14\""), std::string::npos);
 
   const fs::path shot = tmp / "report.png";
   ASSERT_EQ(shell(chromium + "--screenshot=" + shot.string() + " " + url + " >/dev/null 2>&1"), 0);

@@ -5,9 +5,11 @@
 
 namespace clutterseg {
 
-// Weights w_ij = 1/deg(i) for every link, symmetrised W = (W + W^T) / 2. Duplicate links between the
-// same pair keep the first cue. Returned edges have a < b, sorted.
-std::vector<GraphEdge> weight_graph(int num_nodes, std::vector<GraphEdge> links);
+// Weights w_ij = 1/deg(i) for every link, symmetrised W = (W + W^T) / 2, and multiplied by
+// concave_weight for links of cue AdjacentConcave (beyond the paper: the evidence that two patches
+// meet as two objects do). Duplicate links between the same pair keep the first cue. Returned edges
+// have a < b, sorted.
+std::vector<GraphEdge> weight_graph(int num_nodes, std::vector<GraphEdge> links, double concave_weight = 1);
 
 struct Partition {
   std::vector<int> object_of_node;  // 0-based object index per node

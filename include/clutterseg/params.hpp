@@ -59,6 +59,14 @@ struct Params {
     bool skip_similar = true;    // set false to always test
   } cutfree;
 
+  // Beyond the paper: convex or concave junctions between adjacent patches (contact.hpp). A concave
+  // crease is where an object meets what it stands on or leans against.
+  struct Convexity {
+    bool enabled = true;
+    double tolerance = 0.1;      // |mean (n_a - n_b) . (p_a - p_b) / |p_a - p_b|| below this is flat [-]
+    double concave_weight = 0.2; // a concave link's graph weight is multiplied by this [-]
+  } convexity;
+
   // f/g) Co-planarity of flat, non-adjacent patches separated by occlusion.
   struct Coplanarity {
     bool enabled = true;
@@ -92,16 +100,21 @@ struct Params {
     int tiny_px = 20;            // "very few points" at 320x240 [px], scaled (PixelScale)
   } remaining;
 
-  // Support plane (table) detection for the objects-only view.
+  // Beyond the paper: the support plane (table), decided per patch before the graph (support.hpp).
   struct Support {
+    bool enabled = true;         // find the table; its patches never join an object
     bool objects_only = false;   // label 0 for the support plane and background surfaces
-    double plane_band = 0.015;   // pixels within this of the table plane belong to it [m]
+    double plane_band = 0.015;   // a patch lies in the plane when 80 % of its points are within half
+                                 // this; parts of table patches farther above it are cut off [m at 1 m
+                                 // depth, times z^2 beyond: plane_tolerance()]
+    double pixel_band = 0.005;   // an edge pixel higher than this above the plane is no table [m at 1 m]
+    double table_angle_deg = 25; // a table patch's mean normal is within this of the plane's
     double max_height = 0.5;     // objects higher above the table than this are background [m]
-    double contact_distance = 0.05;  // an object rests on a plane when its lowest point is this close [m]
+    double contact_distance = 0.05;  // a patch rests on a plane when its lowest point is this close [m]
     double region_margin = 0.05; // an object stands on the table when it projects within this of the
                                  // table's visible region (convex hull in the plane) [m]
-    double wall_min_extent = 0.35; // a flat object at least this large, roughly perpendicular to the
-                                   // table (> 60 deg), is a wall [m]
+    double wall_min_extent = 0.35; // a flat object roughly perpendicular to the table (> 60 deg) whose
+                                   // largest face is at least this long along the table is a wall [m]
   } support;
 
   std::uint64_t seed = 1;        // every random choice is seeded from this

@@ -87,16 +87,19 @@ struct Patch {
   int occupied_bins = 0;               // bins with share >= Params::Patches::occupied_share
   bool curved = false;                 // occupied_bins >= flat_max_bins
   cv::Rect bbox;                       // image bounding box
+  bool table = false;                  // lies in the support plane (support.hpp)
 };
 
 // Why two patches are linked in the graph.
-enum class Cue : std::uint8_t { Adjacent, Coplanar, CurvatureOpen, CurvatureOccluded };
+// AdjacentConcave: adjacent, meeting in a concave crease (contact.hpp), weighted down by the graph.
+enum class Cue : std::uint8_t { Adjacent, Coplanar, CurvatureOpen, CurvatureOccluded, AdjacentConcave };
 const char* to_string(Cue cue);
 
 struct GraphEdge {
   int a = 0, b = 0;    // patch indices (0-based into the patch table), a < b
   Cue cue = Cue::Adjacent;
   float weight = 0;    // symmetrised 1/deg weight (paper i)
+  float convexity = std::numeric_limits<float>::quiet_NaN();  // adjacent links: PairJunction::convexity
 };
 
 struct OrientedBox {

@@ -1,0 +1,31 @@
+// Beyond the paper: how two adjacent patches meet. Faces of one object meet at convex edges (a box's
+// top and side); an object meets its support, or another object it rests on or leans against, in a
+// concave crease (a box on the table, a can on a cup, a banana on a box). The paper's cut-free test
+// (e) cannot tell these apart: a box face lies on one side of the table's plane whether it stands on
+// the table or is the table's own edge. docs/COMPOSITION.md has the measurements behind the defaults.
+#pragma once
+
+#include "clutterseg/adjacency.hpp"
+#include "clutterseg/normals.hpp"
+#include "clutterseg/params.hpp"
+
+namespace clutterseg {
+
+enum class Junction : std::uint8_t { Convex, Flat, Concave };
+
+struct PairJunction {
+  PatchPair pair;
+  float convexity = 0;  // mean over the contacts of (n_a - n_b) . (p_a - p_b) / |p_a - p_b|, in [-2, 2]
+  int samples = 0;      // contacts it was measured on
+  Junction kind = Junction::Flat;
+};
+
+// For every adjacent pair in `contacts` (sorted by pair, as assign_edge_pixels gives them): the mean
+// convexity of the surfaces on both sides of the edge, at most `max_samples` contacts per pair (an even
+// stride), from the points and the normals (camera-facing) at the two contact pixels. Convex above
+// +tolerance, concave below -tolerance, else flat (coplanar continuations, steps between parallel
+// faces, or too few samples). Sorted by pair.
+std::vector<PairJunction> classify_junctions(const std::vector<Contact>& contacts, const cv::Mat& points,
+                                             const NormalPlanes& normals, const Params::Convexity& params);
+
+}  // namespace clutterseg

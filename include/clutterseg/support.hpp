@@ -1,0 +1,86 @@
+// Beyond the paper (SPEC Sec. 2: the support plane as an output of its own, an objects-only view): the
+// table the objects stand on, decided per patch before the patch graph is built, so that a piece of
+// table never becomes part of an object and an object the edges did not close off from the table is cut
+// out of it. docs/OBJECTS.md has the decisions and their measurements.
+#pragma once
+
+#include <optional>
+
+#include "clutterseg/params.hpp"
+#include "clutterseg/types.hpp"
+
+namespace clutterseg {
+
+// Where a plane is seen: the convex hull of its points in plane coordinates, grown by a margin and
+// rasterised at 1 cm, so that "is this point over the table" is a lookup.
+struct PlaneRegion {
+  Plane plane;
+  Eigen::Vector3f u = Eigen::Vector3f::UnitX(), v = Eigen::Vector3f::UnitY();  // orthonormal basis of the plane
+  cv::Point2f origin;     // plane coordinates [m] of cell (0, 0)
+  cv::Mat cells;          // CV_8U, 255 = over the region; empty = nowhere
+  static constexpr float kCell = 0.01f;  // [m]
+  bool over(const Eigen::Vector3f& q) const {
+    // Cell coordinates; negative ones are outside, so truncation serves as floor.
+    const float fx = (u.dot(q) - origin.x) * (1.f / kCell), fy = (v.dot(q) - origin.y) * (1.f / kCell);
+    if (!(fx >= 0 && fy >= 0 && fx < static_cast<float>(cells.cols) && fy < static_cast<float>(cells.rows))) return false;
+    return cells.at<uchar>(static_cast<int>(fy), static_cast<int>(fx)) != 0;
+  }
+};
+
+// The region of `pixels` (their points projected into `plane`), grown by `margin` [m].
+PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin);
+
+struct Support {
+  Plane plane;         // camera frame, normal facing the camera (up, for a table seen from above)
+  PlaneRegion region;  // the table as seen: hull of all its patches, grown by Params::Support::region_margin
+};
+
+// How far from the plane a point at depth z [m] may lie and still be on it: band * max(1, z^2) [m]. The
+// depth noise and quantisation of structured-light and stereo sensors grow with z^2; at 1 m and closer
+// the band is as given.
+inline float plane_tolerance(double band, float z) { return static_cast<float>(band) * std::max(1.f, z * z); }
+
+// Least-squares plane of the valid points of `pixels` (at most ~3000 read), normal facing the camera.
+bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& plane);
+
+// Share of the valid points of `pixels` (a stride of at most ~2000) within plane_tolerance(band, z) of
+// `plane` is at least `share`; stops as soon as the answer is known.
+bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double band,
+                   double share);
+
+// The support plane: among the large patches that are planar (RANSAC), the one with the most pixels of
+// other patches resting on its camera-facing side (reaching down to within contact_distance of it, at most
+// max_height above it, over its visible region); then
+// refitted over every patch lying in it, twice (a table split into pieces by the objects on it is one
+// plane, and its far pieces are found with a tolerance that grows with depth). Deterministic.
+// Candidates face up: with a pose (Camera::camera_to_robot) within 45 deg of the robot's z axis, without
+// one not facing down the image (walls seen from above, ceilings).
+std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const cv::Mat& points, const Camera& camera,
+                                        const Params::Support& params);
+
+// The camera-frame direction of up: the robot's z axis when a pose is given, else the image's up (-y).
+Eigen::Vector3f up_in_camera(const Camera& camera);
+
+// A patch lying in the plane: mean normal within table_angle_deg of the plane's and at least 80 % of
+// its points within half the plane tolerance.
+bool lies_in(const Patch& patch, const cv::Mat& points, const Plane& plane, const Params::Support& params);
+
+// Patches that are mostly table but hold core pixels standing clear of the plane (more than the plane
+// tolerance above it): objects the edges did not close off (a gap in the edge band, a smooth foot). Marks
+// in `edges` (CV_8U, 255 = edge) the pixels where such a part meets the table part of its patch, so that
+// extracting the patches again separates them. Returns the number of pixels cut off (0: edges unchanged);
+// parts smaller than min_px are left to the table.
+int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
+                  const Plane& plane, const Params::Support& params, int min_px);
+
+// Edge pixels that step d) gave to a table patch but that stand more than pixel_band clear of the plane
+// (the foot of a box face, the lower half of a lying marker): unassigned again (0), for stage j) to give to
+// the object they belong to. Returns how many.
+int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, const std::vector<Patch>& patches,
+                       const cv::Mat& points, const Plane& plane, const Params::Support& params);
+
+// The support with its visible region: the hull of all table patches.
+Support support_of(const Plane& plane, const std::vector<Patch>& patches, const cv::Mat& points,
+                   const Params::Support& params);
+
+}  // namespace clutterseg

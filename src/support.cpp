@@ -1,0 +1,455 @@
+// The support plane (table), decided per patch. See include/clutterseg/support.hpp and docs/OBJECTS.md.
+#include "clutterseg/support.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+
+#include "clutterseg/parallel.hpp"
+
+namespace clutterseg {
+
+namespace {
+
+Eigen::Vector3f point_at(const cv::Vec3f* pts, int i) { return {pts[i][0], pts[i][1], pts[i][2]}; }
+
+// Largest a * x + b * y over the points, a and b in {-1, 0, 1} (exact: no rounding but the one sum).
+CLUTTERSEG_ROW_KERNEL float largest_projection(const float* __restrict x, const float* __restrict y, int n, float a,
+                                               float b) {
+  float largest = -std::numeric_limits<float>::infinity();
+#pragma omp simd reduction(max : largest)
+  for (int i = 0; i < n; ++i) largest = std::max(largest, a * x[i] + b * y[i]);
+  return largest;
+}
+
+// Points with a * x + b * y >= value.
+CLUTTERSEG_ROW_KERNEL int count_at_least(const float* __restrict x, const float* __restrict y, int n, float a, float b,
+                                         float value) {
+  int count = 0;
+  for (int i = 0; i < n; ++i) count += a * x[i] + b * y[i] >= value;
+  return count;
+}
+
+// Index of the first point with a * x + b * y >= value (n if none): blocks are counted in a vectorised
+// pass, and only the block that holds it is scanned point by point.
+int first_at_least(const float* x, const float* y, int n, float a, float b, float value) {
+  constexpr int kBlock = 64;
+  for (int begin = 0; begin < n; begin += kBlock) {
+    const int end = std::min(n, begin + kBlock);
+    if (count_at_least(x + begin, y + begin, end - begin, a, b, value) == 0) continue;
+    for (int i = begin; i < end; ++i)
+      if (a * x[i] + b * y[i] >= value) return i;
+  }
+  return n;
+}
+
+// keep[i] &= (a * x + b * y > offset) for one edge of the inner polygon.
+CLUTTERSEG_ROW_KERNEL void keep_inside(const float* __restrict x, const float* __restrict y, int n, float a, float b,
+                                       float offset, uchar* __restrict keep) {
+  for (int i = 0; i < n; ++i) keep[i] &= static_cast<uchar>(a * x[i] + b * y[i] > offset);
+}
+
+// cv::convexHull of plane points. It sorts every point (~0.4 ms for the 4000 of a table); points more
+// than 1 mm inside the polygon of the extreme points in 8 directions cannot be hull vertices, so
+// dropping them first gives the same hull.
+std::vector<cv::Point2f> convex_hull(const std::vector<cv::Point2f>& points) {
+  const int n = static_cast<int>(points.size());
+  std::vector<float> xs(points.size()), ys(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    xs[i] = points[i].x;
+    ys[i] = points[i].y;
+  }
+  // Extreme points along x, y, x + y and x - y, in counter-clockwise order of direction: the first
+  // point reaching the largest projection.
+  constexpr float kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1}, kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+  std::array<cv::Point2f, 8> extreme;
+  for (int k = 0; k < 8; ++k) {
+    const float largest = largest_projection(xs.data(), ys.data(), n, kDx[k], kDy[k]);
+    const int first = first_at_least(xs.data(), ys.data(), n, kDx[k], kDy[k], largest);
+    extreme[static_cast<size_t>(k)] = points[static_cast<size_t>(first < n ? first : 0)];
+  }
+  std::vector<cv::Point2f> polygon;
+  for (const cv::Point2f& e : extreme)
+    if (polygon.empty() || e != polygon.back()) polygon.push_back(e);
+  if (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
+  // Points more than kMargin inside every edge of that polygon (edges as lines n . p = offset, unit
+  // normal n pointing inwards) cannot be hull vertices.
+  constexpr float kMargin = 0.001f;  // [m], far above the float rounding of plane coordinates
+  std::vector<uchar> inside(points.size(), polygon.size() >= 3 ? 1 : 0);
+  for (size_t k = 0; polygon.size() >= 3 && k < polygon.size(); ++k) {
+    const cv::Point2f edge = polygon[(k + 1) % polygon.size()] - polygon[k];
+    const cv::Point2f normal = cv::Point2f(-edge.y, edge.x) / std::hypot(edge.x, edge.y);
+    keep_inside(xs.data(), ys.data(), n, normal.x, normal.y, normal.dot(polygon[k]) + kMargin, inside.data());
+  }
+  std::vector<cv::Point2f> outer;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (!inside[i]) outer.push_back(points[i]);
+  std::vector<cv::Point2f> hull;
+  cv::convexHull(outer, hull);
+  return hull;
+}
+
+// Dilation of `cells` (0 or 255) by `kernel` (each kernel row a single span of ones, as in an elliptic kernel);
+// the same cells as cv::dilate, which costs ~1 ms on a table-sized region, by painting for every run of
+// set cells the span each kernel row spreads it to (a filled convex polygon has one run per row).
+cv::Mat dilate_by_spans(const cv::Mat& cells, const cv::Mat& kernel) {
+  const cv::Point anchor(kernel.cols / 2, kernel.rows / 2);  // cv::dilate's default anchor
+  std::vector<std::pair<int, int>> span;  // first and last column of ones in each kernel row
+  for (int j = 0; j < kernel.rows; ++j) {
+    const uchar* k = kernel.ptr<uchar>(j);
+    int first = 0, last = kernel.cols - 1;
+    while (first < kernel.cols && !k[first]) ++first;
+    while (last >= first && !k[last]) --last;
+    span.emplace_back(first, last);
+  }
+  cv::Mat out(cells.size(), CV_8U, cv::Scalar(0));
+  const auto cols = static_cast<size_t>(cells.cols);
+  for (int y = 0; y < cells.rows; ++y) {
+    const uchar* row = cells.ptr<uchar>(y);
+    // Runs found by memchr (SIMD): a row is mostly empty or one run.
+    for (int left = 0; left < cells.cols; ++left) {
+      const void* set = std::memchr(row + left, 255, cols - static_cast<size_t>(left));
+      if (!set) break;
+      left = static_cast<int>(static_cast<const uchar*>(set) - row);
+      const void* unset = std::memchr(row + left, 0, cols - static_cast<size_t>(left));
+      const int right = unset ? static_cast<int>(static_cast<const uchar*>(unset) - row) - 1 : cells.cols - 1;
+      // dst(x, y) = max over kernel cells (i, j) of src(x + i - anchor.x, y + j - anchor.y).
+      for (int j = 0; j < kernel.rows; ++j) {
+        const auto [first, last] = span[static_cast<size_t>(j)];
+        const int to_y = y - j + anchor.y;
+        if (last < first || to_y < 0 || to_y >= out.rows) continue;
+        const int x0 = std::max(0, left - last + anchor.x), x1 = std::min(out.cols - 1, right - first + anchor.x);
+        if (x0 <= x1) std::memset(out.ptr<uchar>(to_y) + x0, 255, static_cast<size_t>(x1 - x0 + 1));
+      }
+      left = right;
+    }
+  }
+  return out;
+}
+
+// Every stride-th valid pixel of a patch, at most about `most` of them (bounded work per patch).
+std::vector<int> sample_of(const std::vector<int>& pixels, const cv::Vec3f* pts, size_t most) {
+  std::vector<int> sample;
+  const size_t stride = std::max<size_t>(1, pixels.size() / most);
+  for (size_t k = 0; k < pixels.size(); k += stride)
+    if (valid_point(pts[pixels[k]])) sample.push_back(pixels[k]);
+  return sample;
+}
+
+// Dominant plane of a patch: RANSAC over a sample of its points (a table patch may hold the foot of an
+// object that the edges did not separate), refined by least squares on the inliers. The band grows with
+// the patch's depth (plane_tolerance). Deterministic: the draws are seeded by the patch size. Returns the
+// inlier share.
+double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, double band, Plane& plane) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const std::vector<int> sample = sample_of(pixels, pts, 1000);
+  if (sample.size() < 10) return 0;
+  std::vector<float> tolerance(sample.size());
+  for (size_t k = 0; k < sample.size(); ++k) tolerance[k] = plane_tolerance(band, pts[sample[k]][2]);
+  std::uint64_t state = 0x9e3779b97f4a7c15ULL ^ pixels.size();
+  auto next = [&] {  // xorshift64: a small, portable, seeded generator
+    state ^= state << 13; state ^= state >> 7; state ^= state << 17;
+    return static_cast<size_t>(state % sample.size());
+  };
+  auto inliers_of = [&](const Plane& candidate) {
+    int count = 0;
+    for (size_t k = 0; k < sample.size(); ++k)
+      count += std::abs(candidate.distance(point_at(pts, sample[k]))) <= tolerance[k];
+    return count;
+  };
+  int best_count = -1;
+  Plane best;
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    const Eigen::Vector3f a = point_at(pts, sample[next()]), b = point_at(pts, sample[next()]),
+                          c = point_at(pts, sample[next()]);
+    Eigen::Vector3f n = (b - a).cross(c - a);
+    if (n.norm() < 1e-9f) continue;
+    n.normalize();
+    if (n.dot(a) > 0) n = -n;
+    const Plane candidate{n, -n.dot(a)};
+    const int count = inliers_of(candidate);
+    if (count > best_count) { best_count = count; best = candidate; }
+  }
+  if (best_count <= 0) return 0;
+  std::vector<int> inliers;
+  for (size_t k = 0; k < sample.size(); ++k)
+    if (std::abs(best.distance(point_at(pts, sample[k]))) <= tolerance[k]) inliers.push_back(sample[k]);
+  plane = best;
+  Plane refined;
+  if (fit_plane(inliers, points, refined) && inliers_of(refined) >= best_count) {
+    plane = refined;
+    return static_cast<double>(inliers_of(refined)) / static_cast<double>(sample.size());
+  }
+  return static_cast<double>(best_count) / static_cast<double>(sample.size());
+}
+
+// Least-squares plane of the points within plane_tolerance of `plane` among `pixels` of every patch in
+// `table` (a sample per patch): the table seen as one plane.
+bool refit(const std::vector<Patch>& patches, const std::vector<int>& table, const cv::Mat& points, double band,
+           Plane& plane) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  long n = 0;
+  for (int p : table)
+    for (int i : sample_of(patches[static_cast<size_t>(p)].pixels, pts, 3000)) {
+      const Eigen::Vector3f q = point_at(pts, i);
+      if (std::abs(plane.distance(q)) > plane_tolerance(band, q.z())) continue;
+      const Eigen::Vector3d d = q.cast<double>();
+      sum += d;
+      outer += d * d.transpose();
+      ++n;
+    }
+  if (n < 10) return false;
+  const Eigen::Vector3d mean = sum / static_cast<double>(n);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / static_cast<double>(n) - mean * mean.transpose());
+  if (eig.eigenvalues()(1) < 1e-8) return false;
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  if (normal.dot(mean) > 0) normal = -normal;
+  plane.normal = normal.cast<float>();
+  plane.offset = static_cast<float>(-normal.dot(mean));
+  return true;
+}
+
+// The patches a plane's refit is made from: normal close to the plane's, half of the points within the
+// tolerance (a patch that holds an object's foot still counts).
+std::vector<int> patches_near(const std::vector<Patch>& patches, const cv::Mat& points, const Plane& plane,
+                              const Params::Support& params) {
+  const float min_cos = static_cast<float>(std::cos(params.table_angle_deg * M_PI / 180.0));
+  std::vector<int> near;
+  for (size_t p = 0; p < patches.size(); ++p)
+    if (patches[p].mean_normal.dot(plane.normal) >= min_cos &&
+        mostly_within(patches[p].pixels, points, plane, params.plane_band, 0.5))
+      near.push_back(static_cast<int>(p));
+  return near;
+}
+
+}  // namespace
+
+bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& plane) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / 3000);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  int n = 0;
+  for (size_t k = 0; k < pixels.size(); k += stride) {
+    if (!valid_point(pts[pixels[k]])) continue;
+    const Eigen::Vector3d q = point_at(pts, pixels[k]).cast<double>();
+    sum += q;
+    outer += q * q.transpose();
+    ++n;
+  }
+  if (n < 10) return false;
+  const Eigen::Vector3d mean = sum / n;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / n - mean * mean.transpose());
+  if (eig.eigenvalues()(1) < 1e-8) return false;
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  if (normal.dot(mean) > 0) normal = -normal;
+  plane.normal = normal.cast<float>();
+  plane.offset = static_cast<float>(-normal.dot(mean));
+  return true;
+}
+
+bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double band,
+                   double share) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
+  const size_t visits = (pixels.size() + stride - 1) / stride;
+  int in = 0, n = 0;
+  for (size_t v = 0; v < visits; ++v) {
+    const int i = pixels[v * stride];
+    if (!valid_point(pts[i])) continue;
+    ++n;
+    in += std::abs(plane.distance(point_at(pts, i))) <= plane_tolerance(band, pts[i][2]);
+    // Best final share (in + left) / (n + left); half a point of margin keeps rounding out of it.
+    const double left = static_cast<double>(visits - v - 1);
+    if (in + left < share * (n + left) - 0.5) return false;
+  }
+  return n && static_cast<double>(in) / n >= share;
+}
+
+PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin) {
+  PlaneRegion r;
+  r.plane = plane;
+  r.u = plane.normal.unitOrthogonal();
+  r.v = plane.normal.cross(r.u);
+  const auto* pts = points.ptr<cv::Vec3f>();
+  std::vector<cv::Point2f> projected;
+  for (int i : sample_of(pixels, pts, 4000)) {
+    const Eigen::Vector3f q = point_at(pts, i);
+    projected.emplace_back(r.u.dot(q), r.v.dot(q));
+  }
+  if (projected.size() < 3) return r;
+  const std::vector<cv::Point2f> hull = convex_hull(projected);
+  cv::Rect2f box(hull[0], hull[0]);
+  for (const auto& h : hull) {
+    const float x1 = std::max(box.x + box.width, h.x), y1 = std::max(box.y + box.height, h.y);
+    box.x = std::min(box.x, h.x);
+    box.y = std::min(box.y, h.y);
+    box.width = x1 - box.x;
+    box.height = y1 - box.y;
+  }
+  const int pad = static_cast<int>(std::ceil(margin / PlaneRegion::kCell)) + 1;
+  r.origin = {box.x - pad * PlaneRegion::kCell, box.y - pad * PlaneRegion::kCell};
+  // Bounded: a region larger than 20 m x 20 m is cut (no depth sensor sees one).
+  const int cols = std::min(2000, static_cast<int>(std::ceil(box.width / PlaneRegion::kCell)) + 2 * pad + 1);
+  const int rows = std::min(2000, static_cast<int>(std::ceil(box.height / PlaneRegion::kCell)) + 2 * pad + 1);
+  r.cells = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  std::vector<cv::Point> poly;
+  for (const auto& h : hull)
+    poly.emplace_back(static_cast<int>(std::lround((h.x - r.origin.x) / PlaneRegion::kCell)),
+                      static_cast<int>(std::lround((h.y - r.origin.y) / PlaneRegion::kCell)));
+  cv::fillConvexPoly(r.cells, poly, cv::Scalar(255));
+  if (pad > 1) r.cells = dilate_by_spans(r.cells, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * pad - 1, 2 * pad - 1}));
+  return r;
+}
+
+Eigen::Vector3f up_in_camera(const Camera& camera) {
+  if (camera.camera_to_robot.isIdentity()) return -Eigen::Vector3f::UnitY();  // the image's up
+  return (camera.camera_to_robot.topLeftCorner<3, 3>().transpose() * Eigen::Vector3d::UnitZ()).cast<float>();
+}
+
+std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const cv::Mat& points, const Camera& camera,
+                                        const Params::Support& params) {
+  if (points.type() != CV_32FC3) throw Error("find_support_plane: points must be CV_32FC3");
+  const auto* pts = points.ptr<cv::Vec3f>();
+  size_t patch_pixels = 0;
+  for (const auto& p : patches) patch_pixels += p.pixels.size();
+  // The 4 largest planar patches with >= 2 % of the patch pixels, judged largest first (ties: lower
+  // index), so RANSAC runs only until 4 are found; those facing up are the candidates.
+  std::vector<int> by_size;
+  for (size_t p = 0; p < patches.size(); ++p)
+    if (static_cast<double>(patches[p].pixels.size()) >= 0.02 * static_cast<double>(patch_pixels)) by_size.push_back(static_cast<int>(p));
+  std::stable_sort(by_size.begin(), by_size.end(), [&](int a, int b) {
+    return patches[static_cast<size_t>(a)].pixels.size() > patches[static_cast<size_t>(b)].pixels.size();
+  });
+  // Which way is up: with a pose (camera_to_robot), the robot's z axis, and a support is within 45 deg of
+  // horizontal; without one, the image's up, and a support's normal does not point down the image (a
+  // camera looking straight down sees the table's normal at 90 deg from the image's up).
+  const Eigen::Vector3f up = up_in_camera(camera);
+  const float min_up = camera.camera_to_robot.isIdentity() ? -0.1f : static_cast<float>(std::cos(M_PI / 4));
+  std::vector<int> candidates, large_planes;  // the 4 largest planes; those facing up are candidates
+  std::vector<Plane> planes;
+  for (size_t k = 0; k < by_size.size() && large_planes.size() < 4; ++k) {
+    Plane plane;
+    if (dominant_plane(patches[static_cast<size_t>(by_size[k])].pixels, points, params.plane_band, plane) < 0.6) continue;
+    large_planes.push_back(by_size[k]);
+    if (plane.normal.dot(up) < min_up) continue;  // a wall seen from above, a ceiling: nothing stands on them
+    candidates.push_back(by_size[k]);
+    planes.push_back(plane);
+  }
+  if (candidates.empty()) return std::nullopt;
+
+  // Score: pixels of the other patches (a sample of each) standing on the candidate: above it by more than
+  // the tolerance and at most max_height, over its visible region. Other large planes do not count, so a
+  // wall does not score the table in front of it, nor the floor below it.
+  std::vector<std::vector<int>> samples(patches.size());
+  for (size_t p = 0; p < patches.size(); ++p) samples[p] = sample_of(patches[p].pixels, pts, 500);
+  int best = -1;
+  double best_score = -1;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const Plane& plane = planes[k];
+    const PlaneRegion region = region_of(plane, patches[static_cast<size_t>(candidates[k])].pixels, points, params.region_margin);
+    double score = 0;
+    for (size_t p = 0; p < patches.size(); ++p) {
+      if (std::find(large_planes.begin(), large_planes.end(), static_cast<int>(p)) != large_planes.end() || samples[p].empty()) continue;
+      // A patch rests on the plane when its lowest point over the region is within contact_distance (a
+      // box in front of a wall floats 20 cm off it; a box's side faces reach down to the table it stands on).
+      int standing = 0;
+      float lowest = std::numeric_limits<float>::infinity();
+      for (int i : samples[p]) {
+        const Eigen::Vector3f q = point_at(pts, i);
+        const float h = plane.distance(q);
+        if (h <= -plane_tolerance(params.plane_band, q.z()) || h > params.max_height || !region.over(q)) continue;
+        lowest = std::min(lowest, h);
+        standing += h > plane_tolerance(params.plane_band, q.z());
+      }
+      if (lowest > params.contact_distance) continue;
+      score += static_cast<double>(standing) / static_cast<double>(samples[p].size()) * static_cast<double>(patches[p].pixels.size());
+    }
+    if (score > best_score) { best_score = score; best = static_cast<int>(k); }
+  }
+  // Refit over every patch lying in the plane, twice: the second pass sees the pieces the first one's
+  // better plane brings within the tolerance.
+  Plane plane = planes[static_cast<size_t>(best)];
+  for (int pass = 0; pass < 2; ++pass) {
+    const std::vector<int> near = patches_near(patches, points, plane, params);
+    if (near.empty() || !refit(patches, near, points, params.plane_band, plane)) break;
+  }
+  return plane;
+}
+
+bool lies_in(const Patch& patch, const cv::Mat& points, const Plane& plane, const Params::Support& params) {
+  const float min_cos = static_cast<float>(std::cos(params.table_angle_deg * M_PI / 180.0));
+  return patch.mean_normal.dot(plane.normal) >= min_cos && mostly_within(patch.pixels, points, plane, 0.5 * params.plane_band, 0.8);
+}
+
+int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
+                  const Plane& plane, const Params::Support& params, int min_px) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const int* lab = patch_labels.ptr<int>();
+  const int width = patch_labels.cols, height = patch_labels.rows;
+  cv::Mat clear(patch_labels.size(), CV_8U, cv::Scalar(0));  // core pixels of table patches clear of the plane
+  uchar* mark = clear.ptr<uchar>();
+  int cut = 0;
+  for (const int p : patches_near(patches, points, plane, params)) {
+    const auto& pixels = patches[static_cast<size_t>(p)].pixels;
+    int count = 0;
+    for (int i : pixels) {
+      const Eigen::Vector3f q = point_at(pts, i);
+      count += valid_point(pts[i]) && plane.distance(q) > plane_tolerance(params.plane_band, q.z());
+    }
+    if (count < min_px) continue;
+    for (int i : pixels) {
+      const Eigen::Vector3f q = point_at(pts, i);
+      if (valid_point(pts[i]) && plane.distance(q) > plane_tolerance(params.plane_band, q.z())) mark[i] = 255;
+    }
+    cut += count;
+  }
+  if (cut == 0) return 0;
+  // Where a clear pixel meets a pixel of its patch on the plane, both become edge pixels: the two parts
+  // are no longer 4-connected.
+  uchar* edge = edges.ptr<uchar>();
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const int i = y * width + x;
+      if (!mark[i]) continue;
+      const int neighbours[4] = {x > 0 ? i - 1 : -1, x + 1 < width ? i + 1 : -1, y > 0 ? i - width : -1,
+                                 y + 1 < height ? i + width : -1};
+      for (int j : neighbours)
+        if (j >= 0 && !mark[j] && lab[j] == lab[i]) edge[i] = edge[j] = 255;
+    }
+  return cut;
+}
+
+int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, const std::vector<Patch>& patches,
+                       const cv::Mat& points, const Plane& plane, const Params::Support& params) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const int* core = core_labels.ptr<int>();
+  int* lab = assigned_labels.ptr<int>();
+  const int total = static_cast<int>(assigned_labels.total());
+  int released = 0;
+  for (int i = 0; i < total; ++i) {
+    const int l = lab[i];
+    if (core[i] != 0 || l <= 0 || l > static_cast<int>(patches.size()) || !patches[static_cast<size_t>(l - 1)].table) continue;
+    const Eigen::Vector3f q = point_at(pts, i);
+    if (plane.distance(q) <= plane_tolerance(params.pixel_band, q.z())) continue;
+    lab[i] = 0;
+    ++released;
+  }
+  return released;
+}
+
+Support support_of(const Plane& plane, const std::vector<Patch>& patches, const cv::Mat& points,
+                   const Params::Support& params) {
+  std::vector<int> table_pixels;
+  for (const auto& patch : patches)
+    if (patch.table) table_pixels.insert(table_pixels.end(), patch.pixels.begin(), patch.pixels.end());
+  return {plane, region_of(plane, table_pixels, points, params.region_margin)};
+}
+
+}  // namespace clutterseg
