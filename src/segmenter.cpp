@@ -140,7 +140,8 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
       ? curvature_links(r.patches, linked, r.patch_labels, r.points, r.normals, camera, p) : std::vector<CurvatureLink>{};
   watch.mark("curvature");
   r.graph = patch_graph(r.patches, links, junctions, coplanar, curved, p.convexity);                           // i) graph cut
-  const Partition parts = cut_graph(num_patches, r.graph, p.graph.theta_c);
+  Partition parts = cut_graph(num_patches, r.graph, p.graph.theta_c);
+  if (table) absorb_enclosed_table(r.patches, assignment.adjacent, parts.object_of_node, parts.cut_cost);  // a bowl's floor
   watch.mark("graph_cut");
   std::optional<TableHint> table_hint;
   if (table) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 
 #include "clutterseg/parallel.hpp"
@@ -442,6 +443,64 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
     ++released;
   }
   return released;
+}
+
+int absorb_enclosed_table(std::vector<Patch>& patches, const std::vector<std::pair<int, int>>& adjacent,
+                          std::vector<int>& object_of_patch, std::vector<float>& cut_cost) {
+  const int n = static_cast<int>(patches.size());
+  if (static_cast<int>(object_of_patch.size()) != n) throw Error("absorb_enclosed_table: one object per patch expected");
+  // Groups of table patches adjacent to each other (union-find, path halving).
+  std::vector<int> parent(static_cast<size_t>(n));
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](int v) {
+    while (parent[static_cast<size_t>(v)] != v) v = parent[static_cast<size_t>(v)] = parent[static_cast<size_t>(parent[static_cast<size_t>(v)])];
+    return v;
+  };
+  const auto table = [&](int p) { return patches[static_cast<size_t>(p)].table; };
+  for (const auto& [a, b] : adjacent)
+    if (table(a) && table(b)) parent[static_cast<size_t>(root(a))] = root(b);
+  int largest = -1;
+  for (int p = 0; p < n; ++p)
+    if (table(p) && (largest < 0 || patches[static_cast<size_t>(p)].pixels.size() > patches[static_cast<size_t>(largest)].pixels.size())) largest = p;
+  if (largest < 0) return 0;
+  // Per group: the one object all its non-table neighbours belong to (-1: none yet, -2: several).
+  std::vector<int> neighbour_object(static_cast<size_t>(n), -1);
+  for (const auto& [a, b] : adjacent) {
+    if (table(a) == table(b)) continue;
+    const int group = root(table(a) ? a : b), object = object_of_patch[static_cast<size_t>(table(a) ? b : a)];
+    int& seen = neighbour_object[static_cast<size_t>(group)];
+    seen = seen == -1 || seen == object ? object : -2;
+  }
+  // Enclosed: the group lies inside the image box of that object's patches.
+  std::vector<cv::Rect> object_box(cut_cost.size()), group_box(static_cast<size_t>(n));
+  for (int p = 0; p < n; ++p) {
+    cv::Rect& box = table(p) ? group_box[static_cast<size_t>(root(p))] : object_box[static_cast<size_t>(object_of_patch[static_cast<size_t>(p)])];
+    box = box.empty() ? patches[static_cast<size_t>(p)].bbox : box | patches[static_cast<size_t>(p)].bbox;
+  }
+  int absorbed = 0;
+  for (int p = 0; p < n; ++p) {
+    const int group = root(p), object = neighbour_object[static_cast<size_t>(group)];
+    if (!table(p) || group == root(largest) || object < 0) continue;
+    const cv::Rect& inner = group_box[static_cast<size_t>(group)];
+    if ((inner & object_box[static_cast<size_t>(object)]) != inner) continue;
+    patches[static_cast<size_t>(p)].table = false;
+    object_of_patch[static_cast<size_t>(p)] = object;
+    ++absorbed;
+  }
+  if (absorbed == 0) return 0;
+  // Objects without a patch left are removed; the others keep their order.
+  std::vector<int> new_id(cut_cost.size(), -1);
+  for (int o : object_of_patch) new_id[static_cast<size_t>(o)] = 0;
+  int next = 0;
+  std::vector<float> kept;
+  for (size_t o = 0; o < new_id.size(); ++o)
+    if (new_id[o] == 0) {
+      new_id[o] = next++;
+      kept.push_back(cut_cost[o]);
+    }
+  for (int& o : object_of_patch) o = new_id[static_cast<size_t>(o)];
+  cut_cost = std::move(kept);
+  return absorbed;
 }
 
 Support support_of(const Plane& plane, const std::vector<Patch>& patches, const cv::Mat& points,
