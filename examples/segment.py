@@ -63,7 +63,9 @@ def main():
     else:
         axes[0].set_title(f"{frame.name}: no colour image")
     depth_m = frame.depth.astype(np.float32) * frame.camera.depth_unit_m
-    shown = axes[1].imshow(np.where(depth_m > 0, depth_m, np.nan), cmap="viridis")
+    valid = depth_m[depth_m > 0]
+    near, far = np.percentile(valid, [1, 99]) if valid.size else (0, 1)
+    shown = axes[1].imshow(np.where(depth_m > 0, depth_m, np.nan), cmap="viridis", vmin=near, vmax=far)
     fig.colorbar(shown, ax=axes[1], fraction=0.035, label="depth [m]")
     axes[1].set_title("depth")
 
@@ -74,8 +76,10 @@ def main():
             overlay[labels == o.id] = 0.35
     base = photo.astype(np.float32) / 255 if photo is not None else np.repeat(
         (depth_m / max(depth_m.max(), 1e-6))[..., None], 3, axis=2)
-    axes[2].imshow(np.where(labels[..., None] > 0, 0.35 * base + 0.65 * overlay, base))
-    for o in objects:
+    blended = np.where(labels[..., None] > 0, 0.35 * base + 0.65 * overlay, base)
+    blended[clutterseg.object_boundaries(labels) > 0] = 1  # white outlines
+    axes[2].imshow(blended)
+    for o in objects:  # centroids are in the camera frame (no Camera.camera_to_robot set)
         u, v = project(o.centroid, frame.camera)
         axes[2].text(u, v, str(o.id), color="white", fontsize=8, ha="center", va="center",
                      bbox=dict(boxstyle="round,pad=0.15", fc="black", alpha=0.6, lw=0))

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,7 +24,7 @@ try:
     from . import _clutterseg as _core
 except ImportError as e:  # the source folder python/clutterseg has no compiled module
     raise ImportError(
-        "clutterseg's compiled module is missing here (" + str(e) + "); build it with scripts/build.sh and "
+        f"clutterseg's compiled module is missing in {Path(__file__).parent} ({e}); build it with scripts/build.sh and "
         "use PYTHONPATH=build/python, or install it with scripts/install_python.sh (docs/PYTHON.md)") from e
 
 from ._clutterseg import (  # noqa: F401  (re-exported)
@@ -47,6 +48,8 @@ from ._clutterseg import (  # noqa: F401  (re-exported)
     synth,
     write_labels,
 )
+
+sys.modules[__name__ + ".synth"] = synth  # so that `import clutterseg.synth` works too
 
 __all__ = [
     "Camera", "Segmenter", "Result", "Object", "OrientedBox", "Patch", "GraphEdge", "Plane", "Error",

@@ -1,7 +1,9 @@
 """What a Python user relies on: parameters by dict or keyword with the CLI's names, temporal state kept
 in the Segmenter, results that describe every object, and help() that says what arguments mean."""
+import ast
 import json
 import pydoc
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -122,3 +124,37 @@ def test_dataset_frames(example_frame):
     assert example_frame.label is None
     with pytest.raises(KeyError):
         dataset["nope"]
+
+
+def stub_names(path):
+    """Top-level names of a .pyi file, and the members of each class as "Class.member"."""
+    names = set()
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        if isinstance(node, ast.ClassDef):
+            names |= {f"{node.name}.{n.name}" for n in node.body if isinstance(n, ast.FunctionDef)}
+            names |= {f"{node.name}.{n.target.id}" for n in node.body if isinstance(n, ast.AnnAssign)}
+        if isinstance(node, ast.AnnAssign):
+            names.add(node.target.id)
+    return names
+
+
+def module_names(module):
+    names = set()
+    for name, value in vars(module).items():
+        if name.startswith("__") or isinstance(value, type(module)):
+            continue
+        names.add(name)
+        if isinstance(value, type) and not issubclass(value, Exception):
+            names |= {f"{name}.{m}" for m in vars(value) if not m.startswith("__")}
+    return names
+
+
+def test_the_type_stubs_name_everything_the_module_has():
+    package = Path(clutterseg.__file__).parent
+    assert stub_names(package / "_clutterseg.pyi") >= module_names(clutterseg._clutterseg)
+    assert stub_names(package / "synth.pyi") >= module_names(clutterseg.synth)
+    assert (package / "py.typed").exists()
+    import clutterseg.synth as synth_module
+    assert synth_module is clutterseg.synth
