@@ -307,7 +307,8 @@ def evaluate(dataset: Union[Dataset, PathLike], predict: Callable[[Frame], Any],
 
       predict(frame) -> labels: the method; int (H, W) ids, 0 = not an object (no table, no background)
       reset(): called when a new scene starts (a temporal window must not span two scenes)
-      sequence: without scenes.json, all frames are one scene (as `--sequence`)
+      sequence: without scenes.json, all frames are one scene (as `--sequence`); when `dataset` is a
+                path (a Dataset given keeps its own)
     A frame whose reading or prediction raises clutterseg.Error or ValueError is recorded as failed
     and the run goes on. For clutterseg itself (what eval runs):
         seg = clutterseg.Segmenter(support__objects_only=True)

@@ -65,6 +65,7 @@ void bind_io(py::module_& m) {
       "write_labels",
       [](const fs::path& path, const py::handle& labels) {
         const cv::Mat ids = label_view(labels, "labels");
+        py::gil_scoped_release release;
         write_png_atomic(path, labels_to_u16(ids));
       },
       py::arg("path"), py::arg("labels"),

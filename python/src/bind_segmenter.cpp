@@ -338,7 +338,8 @@ void bind_segmenter(py::module_& m) {
            "or intrinsics that do not fit the image, clutterseg.Error for a frame without any valid depth.\n"
            "The GIL is released while the frame is segmented: Segmenters in different threads run in\n"
            "parallel; calls on one Segmenter from several threads take turns.")
-      .def("reset", &PySegmenter::reset, "Forgets the temporal window: the next frame starts a new stream.")
+      .def("reset", &PySegmenter::reset, py::call_guard<py::gil_scoped_release>(),  // may wait for a frame
+           "Forgets the temporal window: the next frame starts a new stream.")
       .def_property_readonly("_params_json", &PySegmenter::params_json, "parameters as JSON text");
 }
 
