@@ -111,10 +111,39 @@ def _params_json(params: Optional[Mapping[str, Any]], keywords: Mapping[str, Any
     return json.dumps(tree)
 
 
+def _leaves(tree: dict, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    for key, value in tree.items():
+        if isinstance(value, dict):
+            yield from _leaves(value, f"{prefix}{key}.")
+        else:
+            yield f"{prefix}{key}", value
+
+
+def _read_params(text: str) -> str:
+    """The core reads the parameters (params_from_json: names, types, ranges). When its message does not
+    say which parameter it refused, the core reads them one at a time to find it; nothing is checked here."""
+    try:
+        return _core._read_params(text)
+    except ValueError as error:
+        message = str(error)
+        leaves = list(_leaves(json.loads(text)))
+        if any(f"'{key}'" in message for key, _ in leaves):
+            raise
+        for key, value in leaves:
+            single: dict = {}
+            _put(single, key.split("."), value, key)
+            try:
+                _core._read_params(json.dumps(single))
+            except ValueError as refused:
+                reason = str(refused).removeprefix(f"{_PARAMS_WHAT}: ")
+                raise ValueError(f"{_PARAMS_WHAT}: parameter '{key}': {reason}") from None
+        raise
+
+
 def default_params() -> dict:
     """Every parameter with its default, nested as `clutterseg --dump-config` prints it (units:
     include/clutterseg/params.hpp)."""
-    return Segmenter().params
+    return json.loads(_core._read_params("{}"))
 
 
 class Segmenter(_core.Segmenter):
@@ -135,7 +164,7 @@ class Segmenter(_core.Segmenter):
     """
 
     def __init__(self, params: Optional[Mapping[str, Any]] = None, /, **keywords: Any) -> None:
-        super().__init__(_params_json(params, keywords))
+        super().__init__(_read_params(_params_json(params, keywords)))
 
     @property
     def params(self) -> dict:

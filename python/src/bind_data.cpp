@@ -63,7 +63,7 @@ void bind_io(py::module_& m) {
       "Reads a colour image as uint8 (H, W, 3) RGB.");
   m.def(
       "write_labels",
-      [](const fs::path& path, const py::handle& labels) {
+      [](const fs::path& path, const py::object& labels) {
         const cv::Mat ids = label_view(labels, "labels");
         py::gil_scoped_release release;
         write_png_atomic(path, labels_to_u16(ids));
@@ -111,7 +111,7 @@ void bind_metrics(py::module_& m) {
 
   m.def(
       "score_frame",
-      [](const py::handle& ground_truth, const py::handle& prediction) {
+      [](const py::object& ground_truth, const py::object& prediction) {
         const cv::Mat truth = label_view(ground_truth, "ground_truth"), pred = label_view(prediction, "prediction");
         if (truth.size() != pred.size())
           throw py::value_error("prediction: size " + std::to_string(pred.cols) + "x" + std::to_string(pred.rows) +
@@ -130,7 +130,7 @@ void bind_metrics(py::module_& m) {
         py::arg("width"), py::arg("height"),
         "Boundary tolerance of the UOIS Boundary scores: ceil(0.003 * image diagonal) [px] (3 at 640x480).");
   m.def(
-      "object_boundaries", [](const py::handle& labels) { return to_numpy(object_boundaries(label_view(labels, "labels"))); },
+      "object_boundaries", [](const py::object& labels) { return to_numpy(object_boundaries(label_view(labels, "labels"))); },
       py::arg("labels"), "uint8 (H, W): 255 where a pixel's 4-neighbour carries another id (label 0 is never boundary).");
   m.def(
       "mean_std",

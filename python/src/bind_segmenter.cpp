@@ -53,7 +53,7 @@ class PySegmenter {
     }
   }
 
-  std::shared_ptr<PyResult> segment(const py::handle& depth_array, Camera camera) {
+  std::shared_ptr<PyResult> segment(const py::object& depth_array, Camera camera) {
     const cv::Mat depth = view_2d(depth_array, {CV_16U, CV_32F}, "depth");
     if (camera.width == 0 && camera.height == 0) {  // Camera(fx, fy, cx, cy): the size is the image's
       camera.width = depth.cols;
@@ -322,6 +322,17 @@ void bind_segmenter(py::module_& m) {
   bind_camera(m);
   bind_parts(m);
   bind_result(m);
+
+  m.def(
+      "_read_params",
+      [](const std::string& text) {
+        try {
+          return params_to_json(params_from_json(text, "clutterseg.Segmenter params"));
+        } catch (const Error& e) {
+          throw py::value_error(e.what());
+        }
+      },
+      py::arg("params_json"), "every parameter as JSON text, after the core read `params_json` (ValueError if it cannot)");
 
   py::class_<PySegmenter>(m, "Segmenter", "The C++ segmenter; use clutterseg.Segmenter, which takes dicts and keywords.")
       .def(py::init<const std::string&>(), py::arg("params_json"),

@@ -95,10 +95,12 @@ def test_unknown_parameters_raise_value_error_naming_them():
         clutterseg.Segmenter(theta_c=0.6)
 
 
-def test_wrong_parameter_types_raise_value_error():
-    # The core's params_from_json decides; the message starts with what was read.
-    for params in [{"graph": {"theta_c": "high"}}, {"seed": True}, {"smoothing": {"temporal": 3.5}}, {"graph": 0.5}]:
-        with pytest.raises(ValueError, match="^clutterseg.Segmenter params: "):
+def test_wrong_parameter_types_raise_value_error_naming_them():
+    # The core's params_from_json decides; the message names the parameter it refused.
+    for params, key in [({"graph": {"theta_c": "high"}}, "graph.theta_c"), ({"seed": True}, "seed"),
+                        ({"curvature.theta_h": 0.4, "smoothing": {"temporal": 3.5}}, "smoothing.temporal"),
+                        ({"graph": 0.5}, "graph")]:
+        with pytest.raises(ValueError, match=f"^clutterseg.Segmenter params: .*'{key}'"):
             clutterseg.Segmenter(params)
     with pytest.raises(ValueError, match=r"^clutterseg.Segmenter params: parameter 'graph.theta_c' must be a number or a bool, got set$"):
         clutterseg.Segmenter(graph__theta_c={0.5})
