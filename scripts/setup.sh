@@ -11,4 +11,5 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   libgtest-dev libgmock-dev libbenchmark-dev \
   libpcl-dev \
   chromium fonts-dejavu-core \
-  python3 python3-numpy python3-matplotlib python3-opencv >/dev/null
+  python3 python3-numpy python3-matplotlib python3-opencv \
+  pybind11-dev python3-dev python3-pytest python3-venv python3-build python3-setuptools python3-wheel >/dev/null
