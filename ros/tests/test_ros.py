@@ -53,11 +53,12 @@ def frame_index(stamp):
     return int(round((stamp.to_sec() - START) * RATE))
 
 
-def play(master, bag, depth_topic, frames):
-    """rosbag play of the depth image and its camera_info, once the node has subscribed to both."""
+def play(master, bag, depth_topic, frames, delay=0):
+    """rosbag play of the depth image and its camera_info, once the node has subscribed to both (and
+    `delay` s more, for further subscribers to connect)."""
     info_topic = depth_topic.rsplit("/", 1)[0] + "/camera_info"
-    player = master.start(["rosbag", "play", "--quiet", "--wait-for-subscribers", bag, "--topics", depth_topic,
-                           info_topic], "rosbag-play.log")
+    player = master.start(["rosbag", "play", "--quiet", "--wait-for-subscribers", "--delay", str(delay), bag,
+                           "--topics", depth_topic, info_topic], "rosbag-play.log")
     assert player.wait(timeout=frames / RATE + 60) == 0, player.log()
 
 
@@ -158,6 +159,57 @@ def test_node_params(master, tmp_path):
             assert text in log, log
 
 
+def test_node_target_frame(master, tmp_path):
+    """With ~target_frame, objects and the support plane come in that frame through tf2 (compared with a
+    node in the camera frame on the same frames); without a transform they stay in the camera frame and
+    the node says why."""
+    from geometry_msgs.msg import TransformStamped
+    from tf2_msgs.msg import TFMessage
+    # The camera 1 m above base_link, looking along its x axis (optical frame: z forward, x right, y down).
+    camera = TransformStamped()
+    camera.header.frame_id, camera.child_frame_id = "base_link", "camera_depth_optical_frame"
+    camera.transform.translation.x, camera.transform.translation.z = 0.1, 1.0
+    q = camera.transform.rotation
+    q.x, q.y, q.z, q.w = -0.5, 0.5, -0.5, 0.5
+    rotation = np.array([[0, 0, 1], [-1, 0, 0], [0, -1, 0]], float)  # the same rotation as a matrix
+    translation = np.array([0.1, 0.0, 1.0])
+    tf_static = rospy.Publisher("/tf_static", TFMessage, queue_size=1, latch=True)
+    tf_static.publish(TFMessage(transforms=[camera]))
+
+    names = dataset_names(OSD)
+    bag = write_bag(OSD, tmp_path / "osd.bag", "--rate", str(RATE))
+    runs = {"in_camera": {}, "in_base": {"target_frame": "base_link"},
+            "in_nowhere": {"target_frame": "nowhere", "tf_timeout": 0.01}}
+    objects = {name: Collector(f"/{name}/objects", ObjectArray) for name in runs}
+    nodes = {name: start_node(master, name, "/camera/depth/image_raw", params) for name, params in runs.items()}
+    try:
+        for name in runs:
+            objects[name].wait_connected(details=nodes[name].log)
+        play(master, bag, "/camera/depth/image_raw", len(names), delay=1)
+        for name in runs:
+            objects[name].wait_for(len(names), timeout=60, details=nodes[name].log)
+    finally:
+        for name in runs:
+            nodes[name].stop()
+            objects[name].close()
+        tf_static.unregister()
+    for in_camera, in_base, in_nowhere in zip(*(objects[name].snapshot() for name in runs)):
+        assert in_camera.header.stamp == in_base.header.stamp == in_nowhere.header.stamp
+        assert (in_camera.header.frame_id, in_base.header.frame_id, in_nowhere.header.frame_id) == (
+            "camera_depth_optical_frame", "base_link", "camera_depth_optical_frame")
+        assert [o.id for o in in_camera.objects] == [o.id for o in in_base.objects]
+        for a, b in zip(in_camera.objects, in_base.objects):
+            expected = rotation @ np.array([a.centroid.x, a.centroid.y, a.centroid.z]) + translation
+            assert np.allclose([b.centroid.x, b.centroid.y, b.centroid.z], expected, atol=1e-5)
+            assert (a.box_size.x, a.box_size.y, a.box_size.z) == (b.box_size.x, b.box_size.y, b.box_size.z)
+        if in_camera.has_support_plane:  # the plane's normal turns with the camera; its points stay on it
+            n = rotation @ np.array(in_camera.support_plane[:3])
+            assert np.allclose(in_base.support_plane[:3], n, atol=1e-6)
+            on_plane = -in_camera.support_plane[3] * np.array(in_camera.support_plane[:3])
+            assert abs(np.dot(in_base.support_plane[:3], rotation @ on_plane + translation) + in_base.support_plane[3]) < 1e-5
+    assert "no transform from 'camera_depth_optical_frame' to 'nowhere'" in nodes["in_nowhere"].log()
+
+
 def publish_frame(image_pub, info_pub, depth, encoding, info_size, stamp, intrinsics=(525.0, 525.0, 319.5, 239.5)):
     fx, fy, cx, cy = intrinsics
     header = rospy.Header(stamp=stamp, frame_id="camera_depth_optical_frame")
@@ -230,6 +282,13 @@ def test_nodelet(master, tmp_path):
         labels, stats, _, log = segment_bag(master, "clutterseg_nodelet", bag, len(names), start=load)
         assert_same_labels(labels, reference, names, log + manager.log())
         assert_every_frame_processed(stats, len(names))
+        # A refused parameter: the nodelet is not loaded, the manager says why and goes on.
+        rospy.set_param("/bad_nodelet", {"graph": {"theta_x": 0.5}})
+        bad = master.start(["/usr/lib/nodelet/nodelet", "load", "clutterseg_ros/SegmentationNodelet",
+                            "clutterseg_manager", "__name:=bad_nodelet"], "bad-nodelet.log")
+        assert bad.wait(timeout=30) != 0, bad.log()
+        wait_until("the manager's log line", lambda: "(ROS parameter /bad_nodelet/graph/theta_x)" in manager.log(),
+                   timeout=10, details=manager.log)
         assert manager.alive(), manager.log()
     finally:
         manager.stop()
