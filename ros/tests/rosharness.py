@@ -28,7 +28,7 @@ def wait_until(what, condition, timeout, details=None):
     deadline = time.monotonic() + timeout
     while not condition():
         if time.monotonic() > deadline:
-            more = "; log:\n" + details() if details else ""
+            more = ": " + details() if details else ""
             raise AssertionError(f"timed out after {timeout:g} s waiting for {what}{more}")
         time.sleep(0.02)
 
@@ -67,7 +67,7 @@ class Process:
         except subprocess.TimeoutExpired:
             raise AssertionError(f"{self.cmd[0]} still running after {timeout:g} s; log:\n{self.log()}")
 
-    def stop(self, sig=signal.SIGINT, timeout=10):
+    def stop(self, sig=signal.SIGTERM, timeout=10):
         """Asks the process to stop with `sig`; SIGKILL after `timeout` s. Returns its exit code."""
         if self.proc.poll() is None:
             self.proc.send_signal(sig)
@@ -91,6 +91,9 @@ class Master:
             "ROS_HOME": os.path.join(self.tmp, "ros_home"),
             "ROS_LOG_DIR": os.path.join(self.tmp, "ros_log"),
             "ROSCONSOLE_STDOUT_LINE_BUFFERED": "1",
+            # As the launch files do: spinning OpenMP threads make the segmenter several times slower
+            # when the cores are shared (docs/ROS.md), and the tests share two cores with everything.
+            "OMP_WAIT_POLICY": "passive",
             "ROS_PACKAGE_PATH": os.path.dirname(BUILD_PACKAGE),
             "PYTHONPATH": os.pathsep.join(filter(None, [os.path.join(BUILD_PACKAGE, "python"),
                                                         os.environ.get("PYTHONPATH", "")])),
@@ -155,7 +158,8 @@ class Collector:
                    lambda: self.subscriber.get_num_connections() > 0, timeout, details)
 
     def wait_for(self, n, timeout, details=None):
-        wait_until(f"{n} messages on {self.subscriber.resolved_name}", lambda: self.count() >= n, timeout, details)
+        wait_until(f"{n} messages on {self.subscriber.resolved_name}", lambda: self.count() >= n, timeout,
+                   lambda: f"{self.count()} arrived" + ("; " + details() if details else ""))
 
     def close(self):
         self.subscriber.unregister()

@@ -1,6 +1,7 @@
 """The ROS node, nodelet, launch files and bag script against a real master (ros/tests/rosharness.py).
 
 ctest runs each test in a process of its own (ros_node_bag, ros_nodelet, ...), each with its own master.
+Processes are stopped by PID with SIGTERM (roslaunch with SIGINT, which it passes on to its nodes).
 Bags are played at 2 frames per second, slower than the node on the shared 2-core host, so that every
 frame is segmented in order, as `clutterseg segment DIR` does: the labels must then be equal byte for byte.
 """
@@ -76,9 +77,11 @@ def segment_bag(master, name, bag, frames, start=None, params=None, depth_topic=
             c.wait_for(frames, timeout=60, details=node.log)
         assert node.alive(), node.log()
     finally:
-        node.stop()
+        code = node.stop()
         for c in (labels, stats, objects):
             c.close()
+    if start is None:  # the node shuts down cleanly on SIGTERM
+        assert code == 0, node.log()
     return labels.snapshot(), stats.snapshot(), objects.snapshot(), node.log()
 
 
@@ -178,8 +181,9 @@ def test_node_target_frame(master, tmp_path):
 
     names = dataset_names(OSD)
     bag = write_bag(OSD, tmp_path / "osd.bag", "--rate", str(RATE))
-    runs = {"in_camera": {}, "in_base": {"target_frame": "base_link"},
-            "in_nowhere": {"target_frame": "nowhere", "tf_timeout": 0.01}}
+    # Three nodes on the same frames: one thread each, so that together they keep up on two cores.
+    runs = {"in_camera": {"threads": 1}, "in_base": {"target_frame": "base_link", "threads": 1},
+            "in_nowhere": {"target_frame": "nowhere", "tf_timeout": 0.01, "threads": 1}}
     objects = {name: Collector(f"/{name}/objects", ObjectArray) for name in runs}
     nodes = {name: start_node(master, name, "/camera/depth/image_raw", params) for name, params in runs.items()}
     try:
@@ -295,7 +299,8 @@ def test_nodelet(master, tmp_path):
 
 
 def test_launch(master, tmp_path):
-    """bag.launch plays a bag into the node; camera.launch picks each driver's topic and the nodelet."""
+    """bag.launch plays a bag into the node with a parameter file; camera.launch picks each driver's
+    topic, or loads the nodelet into a manager."""
     launch_dir = os.path.join(BUILD_PACKAGE, "launch")
     for driver, topic in (("openni2", "/camera/depth/image_raw"), ("realsense2", "/camera/depth/image_rect_raw")):
         args = subprocess.run(["roslaunch", "--args", "clutterseg", os.path.join(launch_dir, "camera.launch"),
@@ -307,12 +312,19 @@ def test_launch(master, tmp_path):
                                 text=True, timeout=60)
     assert "load clutterseg_ros/SegmentationNodelet /camera/camera_nodelet_manager" in in_manager.stdout, in_manager
 
+    # A parameter file as `clutterseg --dump-config` writes it (JSON is YAML), with two values changed.
+    dumped = subprocess.run([os.environ["CLUTTERSEG_CLI"], "--dump-config"], check=True, capture_output=True,
+                            text=True, timeout=60).stdout
+    config = json.loads(dumped)
+    config["graph"]["theta_c"], config["support"]["objects_only"] = 0.4, True
+    config_path = tmp_path / "params.json"
+    config_path.write_text(json.dumps(config, indent=1))
     names = dataset_names(OSD)
-    reference = cli_labels(OSD, tmp_path / "cli")
+    reference = cli_labels(OSD, tmp_path / "cli", "--config", str(config_path))
     bag = write_bag(OSD, tmp_path / "osd.bag", "--rate", str(RATE))
     labels = Collector("/launched/labels", Image)
-    launch = master.start(["roslaunch", os.path.join(launch_dir, "bag.launch"), f"bag:={bag}", "name:=launched"],
-                          "roslaunch.log")
+    launch = master.start(["roslaunch", os.path.join(launch_dir, "bag.launch"), f"bag:={bag}", "name:=launched",
+                           f"params:={config_path}"], "roslaunch.log")
     try:
         labels.wait_for(len(names), timeout=len(names) / RATE + 60, details=launch.log)
         assert launch.alive(), launch.log()
