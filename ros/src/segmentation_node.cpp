@@ -100,7 +100,7 @@ void SegmentationNode::on_depth(const sensor_msgs::ImageConstPtr& image, const s
   // Refused here, so a malformed frame never displaces a good one waiting for the worker.
   if (const auto problem = check_depth_frame(*image, *info)) {
     ++rejected_;
-    log_throttled("depth image on " + depth_sub_.getTopic() + ": " + *problem + "; frame skipped");
+    log_throttled(*problem, "depth image on " + depth_sub_.getTopic() + ": " + *problem + "; frame skipped");
     return;
   }
   {
@@ -121,15 +121,15 @@ void SegmentationNode::work() {
       frame = std::move(*pending_);
       pending_.reset();
     }
-    const std::string what = "depth image on " + depth_sub_.getTopic();  // no stamp: repeats are throttled
+    const std::string what = "depth image on " + depth_sub_.getTopic();
     try {
       process(frame);
     } catch (const clutterseg::Error& e) {  // the library refused the frame; the node goes on
       ++failed_;
-      log_throttled(what + ": " + e.what());
+      log_throttled(e.what(), what + ": " + e.what());
     } catch (const std::exception& e) {
       ++failed_;
-      log_throttled(what + ": unexpected error: " + e.what());
+      log_throttled(e.what(), what + ": unexpected error: " + e.what());
     }
   }
 }
@@ -227,8 +227,8 @@ Eigen::Isometry3d SegmentationNode::objects_transform(const std_msgs::Header& im
     to.translation() = Eigen::Vector3d(p.x, p.y, p.z);
     return to;
   } catch (const tf2::TransformException& e) {
-    log_throttled("no transform from '" + image_header.frame_id + "' to '" + target_frame_ + "' (" + e.what() +
-                  "); objects published in '" + image_header.frame_id + "'");
+    const std::string frames = "no transform from '" + image_header.frame_id + "' to '" + target_frame_ + "'";
+    log_throttled(frames, frames + "; objects published in '" + image_header.frame_id + "' (" + e.what() + ")");
     return Eigen::Isometry3d::Identity();
   }
 }
@@ -258,19 +258,19 @@ void SegmentationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("recent frames", latency.size());
 }
 
-void SegmentationNode::log_throttled(const std::string& text) {
+void SegmentationNode::log_throttled(const std::string& key, const std::string& message) {
   std::lock_guard<std::mutex> lock(log_mutex_);
   const ros::WallTime now = ros::WallTime::now();
-  if (text == last_log_ && (now - last_log_time_).toSec() < 5.0) {
-    ++suppressed_logs_;
+  if (const auto it = logged_.find(key); it != logged_.end() && (now - it->second.when).toSec() < 5.0) {
+    ++it->second.suppressed;
     return;
   }
+  if (logged_.size() > 64) logged_.clear();  // bounded, whatever the messages
+  Logged& entry = logged_[key];
   const std::string repeats =
-      text == last_log_ && suppressed_logs_ > 0 ? " (" + std::to_string(suppressed_logs_) + " more since the last report)" : "";
-  ROS_ERROR("%s: %s%s", pnh_.getNamespace().c_str(), text.c_str(), repeats.c_str());
-  last_log_ = text;
-  last_log_time_ = now;
-  suppressed_logs_ = 0;
+      entry.suppressed > 0 ? " (" + std::to_string(entry.suppressed) + " more since the last report)" : "";
+  ROS_ERROR("%s: %s%s", pnh_.getNamespace().c_str(), message.c_str(), repeats.c_str());
+  entry = {now, 0};
 }
 
 }  // namespace clutterseg_ros

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -50,8 +51,9 @@ class SegmentationNode {
   // Camera frame -> ~target_frame at the frame's stamp; identity (and camera frame id) without one.
   Eigen::Isometry3d objects_transform(const std_msgs::Header& image_header, std_msgs::Header& objects_header);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
-  // Logs an error; the same text again only every 5 s (a broken stream arrives 30 times a second).
-  void log_throttled(const std::string& text);
+  // Logs `message` as an error; another one with the same `key` only after 5 s (a broken stream
+  // arrives 30 times a second). The key leaves out what varies from frame to frame (stamps, times).
+  void log_throttled(const std::string& key, const std::string& message);
 
   ros::NodeHandle nh_, pnh_;
   clutterseg::Params params_;
@@ -86,10 +88,12 @@ class SegmentationNode {
   std::deque<double> recent_latency_ms_, recent_segment_ms_;
   std::optional<ros::Time> last_stamp_;  // worker only
 
+  struct Logged {
+    ros::WallTime when;
+    int suppressed = 0;
+  };
   std::mutex log_mutex_;
-  std::string last_log_;
-  ros::WallTime last_log_time_;
-  int suppressed_logs_ = 0;
+  std::map<std::string, Logged> logged_;  // by key; a few kinds of problem in practice
 };
 
 }  // namespace clutterseg_ros

@@ -228,7 +228,8 @@ def publish_frame(image_pub, info_pub, depth, encoding, info_size, stamp, intrin
 
 def test_node_malformed(master, tmp_path):
     """Wrong encoding, a size that does not match CameraInfo and an empty depth image are logged and
-    skipped; the node goes on, and the next good frame is segmented as if they had never come."""
+    skipped (a repeat within 5 s only counted); the node goes on, and the next good frame is segmented as
+    if they had never come."""
     name, topic = "clutterseg_malformed", "/malformed/depth/image_raw"
     image_pub = rospy.Publisher(topic, Image, queue_size=10)
     info_pub = rospy.Publisher("/malformed/depth/camera_info", CameraInfo, queue_size=10)
@@ -251,6 +252,9 @@ def test_node_malformed(master, tmp_path):
             publish_frame(image_pub, info_pub, depth, encoding, size, rospy.Time(100 + i))
             wait_until(f"log line '{expected}'", lambda: expected in node.log(), timeout=20)
             assert node.alive(), node.log()
+        # The same problem again within 5 s: counted, not logged again.
+        for i in range(2):
+            publish_frame(image_pub, info_pub, good, "16UC1", (320, 240), rospy.Time(105 + i))
         publish_frame(image_pub, info_pub, good, "16UC1", (640, 480), rospy.Time(110))
         labels.wait_for(1, timeout=30)
         stats.wait_for(1, timeout=30)
@@ -262,8 +266,9 @@ def test_node_malformed(master, tmp_path):
         image_pub.unregister()
         info_pub.unregister()
     last = stats.snapshot()[-1]
-    assert (last.received, last.rejected, last.failed, last.processed) == (4, 2, 1, 1), last
-    assert all("ERROR" in line for line in node.log().splitlines() if "frame skipped" in line)
+    assert (last.received, last.rejected, last.failed, last.processed) == (6, 4, 1, 1), last
+    lines = [line for line in node.log().splitlines() if "frame skipped" in line]
+    assert len(lines) == 2 and all("ERROR" in line for line in lines), lines
     # The bad frames never entered the temporal window: the CLI on that one file gives the same labels.
     single = tmp_path / "cli-single"
     subprocess.run([os.environ["CLUTTERSEG_CLI"], "segment", os.path.join(OSD, "depth", "learn6.png"), "--out",
