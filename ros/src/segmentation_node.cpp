@@ -77,10 +77,11 @@ SegmentationNode::SegmentationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   diagnostics_timer_ = pnh_.createWallTimer(ros::WallDuration(0.25), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
 
   worker_ = std::thread([this] { work(); });
+  input_topic_ = nh_.resolveName("depth/image");  // before subscribing: a nodelet's callbacks start at once
   depth_sub_ = it_.subscribeCamera("depth/image", 1, &SegmentationNode::on_depth, this,
                                    image_transport::TransportHints("raw", ros::TransportHints(), pnh_));
   ROS_INFO("%s: segmenting %s (objects_only %s, target frame '%s')", pnh_.getNamespace().c_str(),
-           depth_sub_.getTopic().c_str(), params_.support.objects_only ? "on" : "off", target_frame_.c_str());
+           input_topic_.c_str(), params_.support.objects_only ? "on" : "off", target_frame_.c_str());
 }
 
 SegmentationNode::~SegmentationNode() {
@@ -100,7 +101,7 @@ void SegmentationNode::on_depth(const sensor_msgs::ImageConstPtr& image, const s
   // Refused here, so a malformed frame never displaces a good one waiting for the worker.
   if (const auto problem = check_depth_frame(*image, *info)) {
     ++rejected_;
-    log_throttled(*problem, "depth image on " + depth_sub_.getTopic() + ": " + *problem + "; frame skipped");
+    log_throttled(*problem, "depth image on " + input_topic_ + ": " + *problem + "; frame skipped");
     return;
   }
   {
@@ -121,7 +122,7 @@ void SegmentationNode::work() {
       frame = std::move(*pending_);
       pending_.reset();
     }
-    const std::string what = "depth image on " + depth_sub_.getTopic();
+    const std::string what = "depth image on " + input_topic_;
     try {
       process(frame);
     } catch (const clutterseg::Error& e) {  // the library refused the frame; the node goes on
@@ -139,7 +140,7 @@ void SegmentationNode::process(const Frame& frame) {
   const std_msgs::Header& header = frame.image->header;
   if (last_stamp_ && header.stamp < *last_stamp_) {  // a bag started again, or the driver restarted
     ROS_WARN("%s: time went backwards on %s; temporal smoothing starts again", pnh_.getNamespace().c_str(),
-             depth_sub_.getTopic().c_str());
+             input_topic_.c_str());
     segmenter_.reset();
   }
   last_stamp_ = header.stamp;

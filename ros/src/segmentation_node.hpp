@@ -58,6 +58,7 @@ class SegmentationNode {
   ros::NodeHandle nh_, pnh_;
   clutterseg::Params params_;
   clutterseg::Segmenter segmenter_;
+  std::string input_topic_;  // the depth image topic after remapping, for log lines (any thread)
   std::string target_frame_;
   double tf_timeout_s_ = 0.05;
 
