@@ -13,3 +13,13 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   chromium fonts-dejavu-core \
   python3 python3-numpy python3-matplotlib python3-opencv \
   pybind11-dev python3-dev python3-pytest python3-venv python3-build python3-setuptools python3-wheel >/dev/null
+# The ROS 1 node (ros/, docs/ROS.md): Debian's ROS 1 packages, message generation (gencpp, genpy and
+# the .msg files), master, launch, bags and rosrun to run it; rospy, OpenCV and pytest for the bag
+# script and the ROS tests.
+$SUDO apt-get install -y -qq --no-install-recommends \
+  libroscpp-dev libxmlrpcpp-dev libimage-transport-dev libcv-bridge-dev libmessage-filters-dev \
+  libnodeletlib-dev libnodeletlib-tools pluginlib-dev libtf2-ros-dev libdiagnostic-updater-dev \
+  libsensor-msgs-dev libgeometry-msgs-dev libvisualization-msgs-dev libstd-msgs-dev libdiagnostic-msgs-dev \
+  python3-gencpp python3-genpy ros-message-generation ros-std-msgs ros-geometry-msgs \
+  python3-rosmaster python3-roslaunch python3-rosbag python3-rospy rosbash rosout \
+  python3-sensor-msgs python3-std-msgs python3-diagnostic-msgs python3-tf2-msgs python3-opencv python3-pytest >/dev/null
