@@ -141,7 +141,7 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   watch.mark("curvature");
   r.graph = patch_graph(r.patches, links, junctions, coplanar, curved, p.convexity);                           // i) graph cut
   Partition parts = cut_graph(num_patches, r.graph, p.graph.theta_c);
-  if (table) absorb_enclosed_table(r.patches, assignment.adjacent, parts.object_of_node, parts.cut_cost);  // a bowl's floor
+  if (table) settle_table(r.patches, assignment.adjacent, parts.object_of_node, parts.cut_cost);  // one table
   watch.mark("graph_cut");
   std::optional<TableHint> table_hint;
   if (table) {

@@ -445,7 +445,7 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
   return released;
 }
 
-int absorb_enclosed_table(std::vector<Patch>& patches, const std::vector<std::pair<int, int>>& adjacent,
+int settle_table(std::vector<Patch>& patches, const std::vector<std::pair<int, int>>& adjacent,
                           std::vector<int>& object_of_patch, std::vector<float>& cut_cost) {
   const int n = static_cast<int>(patches.size());
   if (static_cast<int>(object_of_patch.size()) != n) throw Error("absorb_enclosed_table: one object per patch expected");
@@ -487,7 +487,10 @@ int absorb_enclosed_table(std::vector<Patch>& patches, const std::vector<std::pa
     object_of_patch[static_cast<size_t>(p)] = object;
     ++absorbed;
   }
-  if (absorbed == 0) return 0;
+  // The other pieces are one object: the table (pieces the objects on it cut apart are not linked).
+  const int table_object = object_of_patch[static_cast<size_t>(largest)];
+  for (int p = 0; p < n; ++p)
+    if (table(p)) object_of_patch[static_cast<size_t>(p)] = table_object;
   // Objects without a patch left are removed; the others keep their order.
   std::vector<int> new_id(cut_cost.size(), -1);
   for (int o : object_of_patch) new_id[static_cast<size_t>(o)] = 0;

@@ -79,14 +79,17 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
 int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, const std::vector<Patch>& patches,
                        const cv::Mat& points, const Plane& plane, const Params::Support& params);
 
-// Table pieces enclosed by one object: the floor inside a bowl or a cup lies as low as the table (a few
-// millimetres above it, within the sensor's noise). A group of table patches (adjacent to each other) that
-// does not hold the largest table patch, whose adjacent patches all belong to one object and that lies
-// inside that object's image box joins that object (Patch::table cleared, object_of_patch updated; objects left without patches are removed and
-// the rest renumbered in order). A sliver of table between two objects stays table. Returns the number
-// of patches that joined an object.
-int absorb_enclosed_table(std::vector<Patch>& patches, const std::vector<std::pair<int, int>>& adjacent,
-                          std::vector<int>& object_of_patch, std::vector<float>& cut_cost);
+// After the graph cut, the table is one object: the group of table patches that holds the largest one,
+// and every other piece, whose links the objects on the table cut (their objects are merged into the
+// largest one's). Except pieces enclosed by one object: the floor inside a bowl or a cup lies as low as
+// the table (a few millimetres above it, within the sensor's noise). A group of table patches (adjacent
+// to each other) that does not hold the largest table patch, whose adjacent patches all belong to one
+// object and that lies inside that object's image box joins that object (Patch::table cleared). A sliver
+// of table between two objects stays table. object_of_patch is updated, objects left without patches are
+// removed and the rest renumbered in order (cut_cost with them). Returns the number of patches that
+// joined an object.
+int settle_table(std::vector<Patch>& patches, const std::vector<std::pair<int, int>>& adjacent,
+                 std::vector<int>& object_of_patch, std::vector<float>& cut_cost);
 
 // The support with its visible region: the hull of all table patches.
 Support support_of(const Plane& plane, const std::vector<Patch>& patches, const cv::Mat& points,
