@@ -9,8 +9,9 @@ namespace {
 
 // Contacts read per pair: the mean of this many is as good as of all of them.
 constexpr int kMaxSamples = 64;
-// A pair seen by fewer contacts than this is not judged (one noisy pixel pair is no crease).
-constexpr int kMinSamples = 3;
+// A pair seen by few contacts is judged with a wider margin: the tolerance times kFewSamples / samples
+// (one noisy pixel pair must show a crease three times as sharp).
+constexpr int kFewSamples = 3;
 
 }  // namespace
 
@@ -31,20 +32,26 @@ std::vector<PairJunction> classify_junctions(const std::vector<Contact>& contact
     PairJunction j;
     j.pair = {contacts[begin].a, contacts[begin].b};
     const size_t stride = std::max<size_t>(1, (end - begin) / kMaxSamples);
-    double sum = 0;
+    double sum = 0, out_of_plane = 0;
     for (size_t k = begin; k < end; k += stride) {
       const Contact& c = contacts[k];
       const Eigen::Vector3f d = point(c.pixel_a) - point(c.pixel_b);
       const Eigen::Vector3f dn = normal(c.pixel_a) - normal(c.pixel_b);
+      const Eigen::Vector3f mean_normal = normal(c.pixel_a) + normal(c.pixel_b);
       const float length = d.norm();
-      if (!(length > 1e-4f) || !std::isfinite(dn.squaredNorm())) continue;  // the same point, or no normal
+      if (!(length > 1e-4f) || !(mean_normal.norm() > 1e-3f)) continue;  // the same point, or no normal
       sum += dn.dot(d) / length;
+      out_of_plane += std::abs(mean_normal.normalized().dot(d)) / length;
       ++j.samples;
     }
-    if (j.samples > 0) j.convexity = static_cast<float>(sum / j.samples);
-    if (j.samples >= kMinSamples)
-      j.kind = j.convexity > params.tolerance ? Junction::Convex
-             : j.convexity < -params.tolerance ? Junction::Concave : Junction::Flat;
+    if (j.samples > 0) {
+      j.convexity = static_cast<float>(sum / j.samples);
+      j.step = static_cast<float>(out_of_plane / j.samples);
+    }
+    const double margin = params.tolerance * std::max(1.0, static_cast<double>(kFewSamples) / std::max(1, j.samples));
+    if (j.samples > 0)
+      j.kind = j.convexity > margin ? Junction::Convex : j.convexity < -margin ? Junction::Concave
+             : j.step > params.step ? Junction::Step : Junction::Flat;
     out.push_back(j);
     begin = end;
   }

@@ -32,7 +32,8 @@ std::vector<GraphEdge> patch_graph(const std::vector<Patch>& patches, const std:
   for (const auto& [a, b] : adjacent) {
     const auto j = std::lower_bound(junctions.begin(), junctions.end(), PatchPair(a, b),
                                     [](const PairJunction& x, const PatchPair& p) { return x.pair < p; });
-    const bool concave = j != junctions.end() && j->pair == PatchPair(a, b) && j->kind == Junction::Concave;
+    const bool concave = j != junctions.end() && j->pair == PatchPair(a, b) &&
+                         (j->kind == Junction::Concave || j->kind == Junction::Step);
     links.push_back({a, b, concave ? Cue::AdjacentConcave : Cue::Adjacent, 0,
                      j != junctions.end() && j->pair == PatchPair(a, b) ? j->convexity : std::numeric_limits<float>::quiet_NaN()});
   }
@@ -108,8 +109,11 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   watch.mark("pointcloud");
   const std::optional<Plane> table = p.support.enabled                           // the table (beyond the paper)
       ? find_support_plane(r.patches, r.points, camera, p.support) : std::nullopt;
-  if (table && cut_off_table(r.edges, r.patches, r.core_patch_labels, r.points, *table, p.support,
-                             px.area(p.patches.min_size_px)) > 0) {              // objects the edges left in it
+  const int cut = (table ? cut_off_table(r.edges, r.patches, r.core_patch_labels, r.points, *table, p.support,  // objects
+                                         px.area(p.patches.min_size_px)) : 0) +                           // left in it
+                  (p.patches.split_band > 0 ? split_at_planes(r.edges, r.patches, r.core_patch_labels, r.points,   // patches
+                                                              p.patches.split_band, px.area(p.patches.min_size_px)) : 0);  // of two planes
+  if (cut > 0) {
     patches = extract_patches(r.edges, r.depth, camera, r.normals, p.patches, px.area(p.patches.min_size_px));
     r.core_patch_labels = patches.labels;
     r.patches = std::move(patches.patches);

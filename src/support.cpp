@@ -389,11 +389,31 @@ bool lies_in(const Patch& patch, const cv::Mat& points, const Plane& plane, cons
   return patch.mean_normal.dot(plane.normal) >= min_cos && mostly_within(patch.pixels, points, plane, 0.5 * params.plane_band, 0.8);
 }
 
+namespace {
+
+// Where a marked pixel meets an unmarked pixel of its patch, both become edge pixels: the two parts are
+// no longer 4-connected.
+void separate_marked(cv::Mat& edges, const cv::Mat& mark_image, const cv::Mat& patch_labels) {
+  const uchar* mark = mark_image.ptr<uchar>();
+  const int* lab = patch_labels.ptr<int>();
+  uchar* edge = edges.ptr<uchar>();
+  const int width = patch_labels.cols, height = patch_labels.rows;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const int i = y * width + x;
+      if (!mark[i]) continue;
+      const int neighbours[4] = {x > 0 ? i - 1 : -1, x + 1 < width ? i + 1 : -1, y > 0 ? i - width : -1,
+                                 y + 1 < height ? i + width : -1};
+      for (int j : neighbours)
+        if (j >= 0 && !mark[j] && lab[j] == lab[i]) edge[i] = edge[j] = 255;
+    }
+}
+
+}  // namespace
+
 int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                   const Plane& plane, const Params::Support& params, int min_px) {
   const auto* pts = points.ptr<cv::Vec3f>();
-  const int* lab = patch_labels.ptr<int>();
-  const int width = patch_labels.cols, height = patch_labels.rows;
   cv::Mat clear(patch_labels.size(), CV_8U, cv::Scalar(0));  // core pixels of table patches clear of the plane
   uchar* mark = clear.ptr<uchar>();
   int cut = 0;
@@ -411,19 +431,29 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
     }
     cut += count;
   }
-  if (cut == 0) return 0;
-  // Where a clear pixel meets a pixel of its patch on the plane, both become edge pixels: the two parts
-  // are no longer 4-connected.
-  uchar* edge = edges.ptr<uchar>();
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const int i = y * width + x;
-      if (!mark[i]) continue;
-      const int neighbours[4] = {x > 0 ? i - 1 : -1, x + 1 < width ? i + 1 : -1, y > 0 ? i - width : -1,
-                                 y + 1 < height ? i + width : -1};
-      for (int j : neighbours)
-        if (j >= 0 && !mark[j] && lab[j] == lab[i]) edge[i] = edge[j] = 255;
-    }
+  if (cut > 0) separate_marked(edges, clear, patch_labels);
+  return cut;
+}
+
+int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
+                    double band, int min_px) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  cv::Mat off(patch_labels.size(), CV_8U, cv::Scalar(0));  // pixels of flat patches off their dominant plane
+  uchar* mark = off.ptr<uchar>();
+  int cut = 0;
+  for (const Patch& patch : patches) {
+    if (patch.curved || static_cast<int>(patch.pixels.size()) < 2 * min_px) continue;  // a plane to split at
+    Plane plane;
+    if (dominant_plane(patch.pixels, points, band, plane) < 0.6) continue;
+    int count = 0;
+    for (int i : patch.pixels)
+      count += valid_point(pts[i]) && std::abs(plane.distance(point_at(pts, i))) > plane_tolerance(band, pts[i][2]);
+    if (count < min_px) continue;
+    for (int i : patch.pixels)
+      if (valid_point(pts[i]) && std::abs(plane.distance(point_at(pts, i))) > plane_tolerance(band, pts[i][2])) mark[i] = 255;
+    cut += count;
+  }
+  if (cut > 0) separate_marked(edges, off, patch_labels);
   return cut;
 }
 

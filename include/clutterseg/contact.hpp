@@ -11,11 +11,15 @@
 
 namespace clutterseg {
 
-enum class Junction : std::uint8_t { Convex, Flat, Concave };
+// Step: parallel faces offset along their normal (a book lying on a larger book, a lid on a can): as
+// faces of two objects meet, more often than faces of one.
+enum class Junction : std::uint8_t { Convex, Flat, Concave, Step };
 
 struct PairJunction {
   PatchPair pair;
   float convexity = 0;  // mean over the contacts of (n_a - n_b) . (p_a - p_b) / |p_a - p_b|, in [-2, 2]
+  float step = 0;       // mean |n . (p_a - p_b)| / |p_a - p_b|, n the mean of the two normals: 0 for a
+                        // coplanar continuation, 1 for a step straight along the normals
   int samples = 0;      // contacts it was measured on
   Junction kind = Junction::Flat;
 };
@@ -23,8 +27,9 @@ struct PairJunction {
 // For every adjacent pair in `contacts` (sorted by pair, as assign_edge_pixels gives them): the mean
 // convexity of the surfaces on both sides of the edge, at most `max_samples` contacts per pair (an even
 // stride), from the points and the normals (camera-facing) at the two contact pixels. Convex above
-// +tolerance, concave below -tolerance, else flat (coplanar continuations, steps between parallel
-// faces, or too few samples). Sorted by pair.
+// +tolerance, concave below -tolerance, else a step when step > Params::Convexity::step, else flat
+// (coplanar continuations); a pair seen by fewer than 3 contacts needs a crease 3 / samples times as
+// sharp. Sorted by pair.
 std::vector<PairJunction> classify_junctions(const std::vector<Contact>& contacts, const cv::Mat& points,
                                              const NormalPlanes& normals, const Params::Convexity& params);
 

@@ -40,6 +40,9 @@ struct Params {
     int histogram_bins = 11;     // normal (x, y) histogram bins per axis
     double occupied_share = 0.005;  // a histogram bin counts as occupied above this share [-]
     int flat_max_bins = 8;       // a patch is flat when fewer bins than this are occupied
+    double split_band = 0.008;   // beyond the paper: a flat patch with a part of at least min_size_px
+                                 // farther than this from its dominant plane is split there [m at 1 m,
+                                 // times z^2 beyond]; 0 = off
   } patches;
 
   // d) Adjacency and assignment of edge pixels to the nearest patch.
@@ -64,7 +67,10 @@ struct Params {
   struct Convexity {
     bool enabled = true;
     double tolerance = 0.1;      // |mean (n_a - n_b) . (p_a - p_b) / |p_a - p_b|| below this is flat [-]
-    double concave_weight = 0.2; // a concave link's graph weight is multiplied by this [-]
+    double step = 0.5;           // a flat junction is a step between parallel faces when the points across
+                                 // it are offset along the normal by more than this share of their distance
+                                 // (sin of 30 deg) [-]
+    double concave_weight = 0.2; // a concave or step link's graph weight is multiplied by this [-]
   } convexity;
 
   // f/g) Co-planarity of flat, non-adjacent patches separated by occlusion.

@@ -73,6 +73,14 @@ bool lies_in(const Patch& patch, const cv::Mat& points, const Plane& plane, cons
 int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                   const Plane& plane, const Params::Support& params, int min_px);
 
+// Beyond the paper: a flat patch that holds two surfaces (two boxes' parallel tops at different heights,
+// joined through a gap in the edges) is split at its dominant plane (RANSAC, plane_tolerance(band, z)):
+// when at least min_px of its pixels lie off that plane, the edge pixels between the two parts are
+// marked in `edges`, as for cut_off_table. Curved patches (Patch::curved: a half-cylinder is half a plane
+// too) and patches with less than 60 % of their points on a plane are left alone. Returns the number of pixels cut off.
+int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
+                    double band, int min_px);
+
 // Edge pixels that step d) gave to a table patch but that stand more than pixel_band clear of the plane
 // (the foot of a box face, the lower half of a lying marker): unassigned again (0), for stage j) to give to
 // the object they belong to. Returns how many.
