@@ -112,7 +112,8 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   const int cut = (table ? cut_off_table(r.edges, r.patches, r.core_patch_labels, r.points, *table, p.support,  // objects
                                          px.area(p.patches.min_size_px)) : 0) +                           // left in it
                   (p.patches.split_band > 0 ? split_at_planes(r.edges, r.patches, r.core_patch_labels, r.points,   // patches
-                                                              p.patches.split_band, px.area(p.patches.min_size_px)) : 0);  // of two planes
+                                                              p.patches.split_band, px.area(p.patches.min_size_px),  // of two
+                                                              table, p.support) : 0);                                 // planes
   if (cut > 0) {
     patches = extract_patches(r.edges, r.depth, camera, r.normals, p.patches, px.area(p.patches.min_size_px));
     r.core_patch_labels = patches.labels;

@@ -411,24 +411,52 @@ void separate_marked(cv::Mat& edges, const cv::Mat& mark_image, const cv::Mat& p
 
 }  // namespace
 
+namespace {
+
+// The pixels of `pixels` (valid points) farther from `plane` than plane_tolerance(band, z), on either side.
+std::vector<int> off_plane(const std::vector<int>& pixels, const cv::Vec3f* pts, const Plane& plane, double band) {
+  const float a = plane.normal.x(), b = plane.normal.y(), c = plane.normal.z(), d = plane.offset;
+  const float k = static_cast<float>(band);
+  std::vector<int> off;
+  for (int i : pixels) {
+    const float x = pts[i][0], y = pts[i][1], z = pts[i][2];
+    const float h = a * x + b * y + c * z + d, tolerance = k * std::max(1.f, z * z);
+    if (valid_depth(z) && std::abs(h) > tolerance) off.push_back(i);
+  }
+  return off;
+}
+
+}  // namespace
+
+namespace {
+
+// above[i] = 255 where point i (interleaved xyz) is valid and higher above the plane than k * max(1, z^2).
+CLUTTERSEG_ROW_KERNEL void mark_above_plane(const float* __restrict xyz, int n, float a, float b, float c, float d,
+                                            float k, uchar* __restrict above) {
+  for (int i = 0; i < n; ++i) {
+    const float x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
+    above[i] = valid_depth(z) & (a * x + b * y + c * z + d > k * std::max(1.f, z * z)) ? 255 : 0;
+  }
+}
+
+}  // namespace
+
 int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                   const Plane& plane, const Params::Support& params, int min_px) {
-  const auto* pts = points.ptr<cv::Vec3f>();
+  // Every pixel's height once, in one vectorised pass; then the table patches' pixels are looked up.
+  cv::Mat above(patch_labels.size(), CV_8U);
+  mark_above_plane(points.ptr<float>(), static_cast<int>(points.total()), plane.normal.x(), plane.normal.y(),
+                   plane.normal.z(), plane.offset, static_cast<float>(params.plane_band), above.ptr<uchar>());
+  const uchar* is_above = above.ptr<uchar>();
   cv::Mat clear(patch_labels.size(), CV_8U, cv::Scalar(0));  // core pixels of table patches clear of the plane
   uchar* mark = clear.ptr<uchar>();
   int cut = 0;
   for (const int p : patches_near(patches, points, plane, params)) {
     const auto& pixels = patches[static_cast<size_t>(p)].pixels;
     int count = 0;
-    for (int i : pixels) {
-      const Eigen::Vector3f q = point_at(pts, i);
-      count += valid_point(pts[i]) && plane.distance(q) > plane_tolerance(params.plane_band, q.z());
-    }
+    for (int i : pixels) count += is_above[i] != 0;
     if (count < min_px) continue;
-    for (int i : pixels) {
-      const Eigen::Vector3f q = point_at(pts, i);
-      if (valid_point(pts[i]) && plane.distance(q) > plane_tolerance(params.plane_band, q.z())) mark[i] = 255;
-    }
+    for (int i : pixels) mark[i] = is_above[i];
     cut += count;
   }
   if (cut > 0) separate_marked(edges, clear, patch_labels);
@@ -436,22 +464,22 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
 }
 
 int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
-                    double band, int min_px) {
+                    double band, int min_px, const std::optional<Plane>& table, const Params::Support& support) {
   const auto* pts = points.ptr<cv::Vec3f>();
   cv::Mat off(patch_labels.size(), CV_8U, cv::Scalar(0));  // pixels of flat patches off their dominant plane
   uchar* mark = off.ptr<uchar>();
+  const std::vector<int> near_table = table ? patches_near(patches, points, *table, support) : std::vector<int>{};
   int cut = 0;
-  for (const Patch& patch : patches) {
+  for (size_t p = 0; p < patches.size(); ++p) {
+    const Patch& patch = patches[p];
     if (patch.curved || static_cast<int>(patch.pixels.size()) < 2 * min_px) continue;  // a plane to split at
+    if (std::binary_search(near_table.begin(), near_table.end(), static_cast<int>(p))) continue;  // cut_off_table's
     Plane plane;
     if (dominant_plane(patch.pixels, points, band, plane) < 0.6) continue;
-    int count = 0;
-    for (int i : patch.pixels)
-      count += valid_point(pts[i]) && std::abs(plane.distance(point_at(pts, i))) > plane_tolerance(band, pts[i][2]);
-    if (count < min_px) continue;
-    for (int i : patch.pixels)
-      if (valid_point(pts[i]) && std::abs(plane.distance(point_at(pts, i))) > plane_tolerance(band, pts[i][2])) mark[i] = 255;
-    cut += count;
+    const std::vector<int> outside = off_plane(patch.pixels, pts, plane, band);
+    if (static_cast<int>(outside.size()) < min_px) continue;
+    for (int i : outside) mark[i] = 255;
+    cut += static_cast<int>(outside.size());
   }
   if (cut > 0) separate_marked(edges, off, patch_labels);
   return cut;
@@ -462,13 +490,15 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
   const auto* pts = points.ptr<cv::Vec3f>();
   const int* core = core_labels.ptr<int>();
   int* lab = assigned_labels.ptr<int>();
-  const int total = static_cast<int>(assigned_labels.total());
+  const int total = static_cast<int>(assigned_labels.total()), num_patches = static_cast<int>(patches.size());
+  const float a = plane.normal.x(), b = plane.normal.y(), c = plane.normal.z(), d = plane.offset;
+  const auto k = static_cast<float>(params.pixel_band);
   int released = 0;
   for (int i = 0; i < total; ++i) {
     const int l = lab[i];
-    if (core[i] != 0 || l <= 0 || l > static_cast<int>(patches.size()) || !patches[static_cast<size_t>(l - 1)].table) continue;
-    const Eigen::Vector3f q = point_at(pts, i);
-    if (plane.distance(q) <= plane_tolerance(params.pixel_band, q.z())) continue;
+    if (l == core[i] || l <= 0 || l > num_patches) continue;  // a core pixel, or no patch: not an edge pixel's
+    const float x = pts[i][0], y = pts[i][1], z = pts[i][2];
+    if (!patches[static_cast<size_t>(l - 1)].table || a * x + b * y + c * z + d <= k * std::max(1.f, z * z)) continue;
     lab[i] = 0;
     ++released;
   }

@@ -77,9 +77,10 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
 // joined through a gap in the edges) is split at its dominant plane (RANSAC, plane_tolerance(band, z)):
 // when at least min_px of its pixels lie off that plane, the edge pixels between the two parts are
 // marked in `edges`, as for cut_off_table. Curved patches (Patch::curved: a half-cylinder is half a plane
-// too) and patches with less than 60 % of their points on a plane are left alone. Returns the number of pixels cut off.
+// too), patches with less than 60 % of their points on a plane and patches near the table's plane (which
+// cut_off_table splits at that plane) are left alone. Returns the number of pixels cut off.
 int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
-                    double band, int min_px);
+                    double band, int min_px, const std::optional<Plane>& table, const Params::Support& support);
 
 // Edge pixels that step d) gave to a table patch but that stand more than pixel_band clear of the plane
 // (the foot of a box face, the lower half of a lying marker): unassigned again (0), for stage j) to give to

@@ -1,0 +1,100 @@
+// Beyond the paper: the table, decided per patch (support.hpp), on scenes and patch lists built for it.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <set>
+
+#include "clutterseg/patches.hpp"
+#include "clutterseg/support.hpp"
+#include "scene_patches.hpp"
+
+using namespace clutterseg;
+using namespace clutterseg::scenes;
+
+namespace {
+
+Patch patch_with(int id, std::vector<int> pixels, bool table, cv::Rect bbox) {
+  Patch p;
+  p.id = id;
+  p.pixels = std::move(pixels);
+  p.table = table;
+  p.bbox = bbox;
+  return p;
+}
+
+}  // namespace
+
+TEST(Support, TheTableNotTheWallAndNotAPlaneFacingDown) {
+  const Segmented s = segment_scene(box_before_wall());
+  ASSERT_TRUE(s.result.support_plane);
+  EXPECT_GT(s.result.support_plane->normal.dot(direction_up(box_before_wall())), 0.99f);
+  // Every table patch lies in the plane, and no box patch does.
+  for (const Patch& p : s.result.patches) {
+    const int label = majority_label(p.pixels, s.truth.labels);
+    if (label == 1) EXPECT_FALSE(p.table) << "patch " << p.id;
+  }
+}
+
+TEST(Support, APatchOfTwoParallelTopsIsSplitAtItsPlane) {
+  // A box and a smaller one beside it, their tops 2 cm apart in height; one patch holding both tops, as
+  // if the edges had a gap between them.
+  TestScene scene{{{table(), box(1, {-0.06, 0, 0.05}, {0.06, 0.05, 0.05}), box(2, {0.03, 0, 0.07}, {0.03, 0.04, 0.07})}}};
+  const auto truth = scene.render();
+  const cv::Mat points = depth_to_points(truth.depth, scene.camera);
+  const Eigen::Vector3f up = direction_up(scene);
+  cv::Mat labels(truth.depth.size(), CV_32S, cv::Scalar(0)), edges(truth.depth.size(), CV_8U, cv::Scalar(255));
+  std::vector<int> tops;
+  for (int i = 0; i < static_cast<int>(truth.depth.total()); ++i) {
+    const cv::Vec3f n = truth.normals.ptr<cv::Vec3f>()[i];
+    if (truth.labels.ptr<int>()[i] > 0 && Eigen::Vector3f(n[0], n[1], n[2]).dot(up) > 0.99f) {
+      tops.push_back(i);
+      labels.ptr<int>()[i] = 1;
+      edges.ptr<uchar>()[i] = 0;
+    }
+  }
+  Patch both = patch_with(1, tops, false, cv::Rect(0, 0, 1, 1));
+  ASSERT_GT(split_at_planes(edges, {both}, labels, points, 0.008, 50, std::nullopt, Params::Support{}), 50);
+  // The cut leaves two 4-connected parts, one per box.
+  cv::Mat parts;
+  const int count = cv::connectedComponents(edges == 0, parts, 4) - 1;
+  std::set<int> box_of_part[3];
+  for (int i : tops) box_of_part[truth.labels.ptr<int>()[i]].insert(parts.ptr<int>()[i]);
+  EXPECT_GE(count, 2);
+  for (int part : box_of_part[1]) EXPECT_FALSE(part > 0 && box_of_part[2].count(part)) << "part " << part << " holds both tops";
+  // A curved patch is never split, whatever its points.
+  both.curved = true;
+  cv::Mat untouched(truth.depth.size(), CV_8U, cv::Scalar(0));
+  EXPECT_EQ(split_at_planes(untouched, {both}, labels, points, 0.008, 50, std::nullopt, Params::Support{}), 0);
+}
+
+TEST(Support, TablePiecesAreOneObjectButAFloorInsideAnObjectJoinsIt) {
+  // Patches: 0 the table (largest), 1 a piece of table between objects 1 and 2, 2 a bowl's wall, 3 the
+  // floor inside it, 4 a box.
+  std::vector<Patch> patches = {patch_with(1, std::vector<int>(100), true, {0, 0, 100, 100}),
+                                patch_with(2, std::vector<int>(10), true, {40, 40, 5, 5}),
+                                patch_with(3, std::vector<int>(30), false, {10, 10, 20, 20}),
+                                patch_with(4, std::vector<int>(10), true, {15, 15, 5, 5}),
+                                patch_with(5, std::vector<int>(30), false, {50, 40, 10, 10})};
+  const std::vector<std::pair<int, int>> adjacent = {{0, 2}, {0, 4}, {1, 2}, {1, 4}, {2, 3}};
+  std::vector<int> object_of_patch = {0, 1, 2, 3, 4};  // every patch its own object, as after the cut
+  std::vector<float> cut_cost = {10, 11, 12, 13, 14};
+  EXPECT_EQ(settle_table(patches, adjacent, object_of_patch, cut_cost), 1);
+  EXPECT_FALSE(patches[3].table);
+  EXPECT_TRUE(patches[1].table);
+  // Table pieces 0 and 1 are one object, the floor is the bowl's; objects renumbered in order.
+  EXPECT_EQ(object_of_patch, (std::vector<int>{0, 0, 1, 1, 2}));
+  EXPECT_EQ(cut_cost, (std::vector<float>{10, 12, 14}));
+}
+
+TEST(Support, EdgePixelsGivenToTheTableAboveItAreReleased) {
+  const Segmented s = segment_scene(box_on_plane());
+  ASSERT_TRUE(s.result.support_plane);
+  const Plane& plane = *s.result.support_plane;
+  // Every pixel the table kept after step d) lies within the pixel band of its plane.
+  for (int i = 0; i < static_cast<int>(s.result.patch_labels.total()); ++i) {
+    const int l = s.result.patch_labels.ptr<int>()[i];
+    if (l <= 0 || !s.result.patches[static_cast<size_t>(l - 1)].table) continue;
+    const cv::Vec3f q = s.result.points.ptr<cv::Vec3f>()[i];
+    ASSERT_LE(plane.distance({q[0], q[1], q[2]}), plane_tolerance(Params{}.support.pixel_band, q[2]) + 1e-6f) << "pixel " << i;
+  }
+}
