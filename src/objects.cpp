@@ -8,8 +8,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
@@ -263,7 +261,6 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
     const Heights& h = heights[o];
     if (object.support || h.samples == 0) continue;
     const double n = h.samples;
-    if (std::getenv("CS_DEBUG")) fprintf(stderr, "object %d: samples %d above_max %d below %d over %d\n", object.id, h.samples, h.above_max, h.below, h.over_region);
     // Far surfaces, the floor below the table, surfaces beside it.
     if (h.above_max > 0.5 * n || h.below > 0.5 * n || h.over_region < 0.3 * n) { object.background = true; continue; }
     // Walls: flat, standing roughly perpendicular to the table, and long along it (a tall box's face is

@@ -239,8 +239,25 @@ void mean_within_band(const std::vector<const float*>& rows, const float* centre
 
 }  // namespace
 
-cv::Mat TemporalSmoother::make_room(const cv::Size& size, const Params::Smoothing& params) {
-  if (!window_.empty() && window_.back().size() != size) window_.clear();
+bool scene_changed(const cv::Mat& previous, const cv::Mat& next, const Params::Smoothing& params) {
+  if (previous.size() != next.size()) return true;
+  // A sample of the pixels (every 4th of every 4th row) is plenty for a share.
+  int both = 0, moved = 0;
+  const auto k = static_cast<float>(params.temporal_band);
+  for (int y = 0; y < next.rows; y += 4) {
+    const float* a = previous.ptr<float>(y);
+    const float* b = next.ptr<float>(y);
+    for (int x = 0; x < next.cols; x += 4) {
+      if (!valid_depth(a[x]) || !valid_depth(b[x])) continue;
+      ++both;
+      moved += std::abs(b[x] - a[x]) > k * b[x] * b[x];
+    }
+  }
+  return both == 0 || moved > params.scene_change_share * both;
+}
+
+cv::Mat TemporalSmoother::make_room(const cv::Mat& next, const Params::Smoothing& params) {
+  if (!window_.empty() && scene_changed(window_.back(), next, params)) window_.clear();
   cv::Mat slot;
   while (static_cast<int>(window_.size()) >= std::max(1, params.temporal_frames)) {
     slot = std::move(window_.front());
@@ -250,14 +267,14 @@ cv::Mat TemporalSmoother::make_room(const cv::Size& size, const Params::Smoothin
 }
 
 cv::Mat TemporalSmoother::push(const cv::Mat& depth, const Params::Smoothing& params) {
-  cv::Mat slot = make_room(depth.size(), params);  // the leaving frame's buffer takes the new one (no allocation)
+  cv::Mat slot = make_room(depth, params);  // the leaving frame's buffer takes the new one (no allocation)
   depth.copyTo(slot);
   window_.push_back(slot);
   return smooth_newest(params);
 }
 
 cv::Mat TemporalSmoother::push(cv::Mat&& depth, const Params::Smoothing& params) {
-  make_room(depth.size(), params);
+  make_room(depth, params);
   window_.push_back(std::move(depth));
   return smooth_newest(params);
 }

@@ -18,6 +18,8 @@ struct Params {
     int temporal_frames = 6;     // n: window length [frames]
     double temporal_band = 0.01;   // k [1/m]: values within k*z^2 of the newest are averaged
                                    // (10 mm at 1 m: 5 sigma of Kinect v1 axial noise; docs/PRESEGMENTATION.md)
+    double scene_change_share = 0.5;  // the window restarts when more than this share of the pixels moved
+                                      // beyond the band since the previous frame (a new scene) [-]
   } smoothing;
 
   // a) Normals by cross product of image neighbours on the organized 3D points, then Gaussian-smoothed.

@@ -15,9 +15,15 @@ cv::Mat depth_to_metres(const cv::Mat& depth, const Camera& camera);
 // 3x3 median over the valid neighbours of each valid pixel; invalid pixels stay invalid.
 cv::Mat median_depth(const cv::Mat& depth);
 
+// The next frame shows another scene than the previous one: more than scene_change_share of the pixels
+// measured in both moved by more than the temporal band (a cut in a video, a folder of unrelated frames,
+// a camera that moved), or the size changed.
+bool scene_changed(const cv::Mat& previous, const cv::Mat& next, const Params::Smoothing& params);
+
 // Motion-sensitive temporal smoothing over the last n frames: a pixel becomes the mean of the window's
 // values that lie within band = k * z^2 of its newest value, so static surfaces are averaged and moving
 // ones keep their newest depth (no motion blur). A pixel invalid in the newest frame stays invalid.
+// A new scene empties the window first (scene_changed): frames of unrelated scenes are never averaged.
 class TemporalSmoother {
  public:
   // Adds a copy of `depth` to the window and returns the smoothed newest frame.
@@ -29,7 +35,7 @@ class TemporalSmoother {
   int size() const { return static_cast<int>(window_.size()); }
 
  private:
-  cv::Mat make_room(const cv::Size& size, const Params::Smoothing& params);  // the buffer of the frame that leaves
+  cv::Mat make_room(const cv::Mat& next, const Params::Smoothing& params);  // the buffer of the frame that leaves
   cv::Mat smooth_newest(const Params::Smoothing& params) const;
   std::deque<cv::Mat> window_;  // newest last
 };
