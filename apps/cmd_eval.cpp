@@ -84,41 +84,6 @@ Params with_value(const Params& base, const Sweep& sweep, double value) {
   return params_from_json(j.dump(), "--sweep");
 }
 
-struct FrameInfo {
-  std::string family = "all", scene;
-};
-
-// Families and scenes from DATASET/scenes.json {"frames": [{"name", "family", "scene"?}, ...]}.
-// Without a scene entry every frame is its own scene, or all frames one scene with --sequence.
-std::map<std::string, FrameInfo> frame_infos(const fs::path& dataset, const FrameSource& source, bool sequence) {
-  std::map<std::string, FrameInfo> infos;
-  for (size_t i = 0; i < source.size(); ++i)
-    infos[source.name(i)] = {"all", sequence ? std::string("sequence") : source.name(i)};
-  const fs::path file = dataset / "scenes.json";
-  if (!fs::exists(file)) return infos;
-  nlohmann::json j;
-  try {
-    std::ifstream in(file);
-    j = nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    throw Error(file.string() + ": is not valid JSON");
-  }
-  if (!j.is_object() || !j.contains("frames") || !j["frames"].is_array())
-    throw Error(file.string() + ": expected {\"frames\": [{\"name\": ..., \"family\": ...}, ...]}");
-  for (auto& [name, info] : infos) info.family = "unlisted";
-  for (const auto& f : j["frames"]) {
-    if (!f.is_object() || !f.contains("name") || !f["name"].is_string())
-      throw Error(file.string() + ": every frame needs a \"name\"");
-    const auto it = infos.find(f["name"].get<std::string>());
-    if (it == infos.end()) continue;  // a frame the dataset does not hold
-    // A listed frame without a family is only in "all" (scenes.json may name scenes only).
-    it->second.family = f.contains("family") && f["family"].is_string() ? f["family"].get<std::string>() : "all";
-    if (f.contains("scene") && (f["scene"].is_string() || f["scene"].is_number()))
-      it->second.scene = f["scene"].is_string() ? f["scene"].get<std::string>() : f["scene"].dump();
-  }
-  return infos;
-}
-
 cv::Mat depth_in_metres(const Frame& frame) {
   cv::Mat m;
   if (frame.depth.depth() == CV_16U) {

@@ -56,10 +56,19 @@ int run(const SegmentOptions& o) {
   const Params params = o.params.resolve();
   FrameSource source(o.input, o.camera);
   Segmenter segmenter(params);
+  // A dataset's scenes.json says where one scene ends and the next begins: the temporal window never
+  // spans two scenes. Without it the frames are one stream and the smoother detects cuts itself.
+  const fs::path folder = fs::is_directory(o.input) ? fs::path(o.input) : fs::path(o.input).parent_path();
+  const auto infos = frame_infos(folder, source, /*sequence=*/true);
+  std::string scene = source.size() > 0 ? infos.at(source.name(0)).scene : "";
   Progress progress("segment", source.size());
   int failed = 0;
   for (size_t i = 0; i < source.size(); ++i) {
     try {
+      if (const std::string& s = infos.at(source.name(i)).scene; s != scene) {
+        segmenter.reset();
+        scene = s;
+      }
       const Frame frame = source.load(i);
       Result r;
       try {

@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "clutterseg/config.hpp"
@@ -150,5 +152,36 @@ Progress::~Progress() {
 }
 
 void report_error(const std::string& message) { std::cerr << "clutterseg: " << message << "\n"; }
+
+// Families and scenes from DATASET/scenes.json {"frames": [{"name", "family", "scene"?}, ...]}.
+// Without a scene entry every frame is its own scene, or all frames one scene with --sequence.
+std::map<std::string, FrameInfo> frame_infos(const fs::path& dataset, const FrameSource& source, bool sequence) {
+  std::map<std::string, FrameInfo> infos;
+  for (size_t i = 0; i < source.size(); ++i)
+    infos[source.name(i)] = {"all", sequence ? std::string("sequence") : source.name(i)};
+  const fs::path file = dataset / "scenes.json";
+  if (!fs::exists(file)) return infos;
+  nlohmann::json j;
+  try {
+    std::ifstream in(file);
+    j = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw Error(file.string() + ": is not valid JSON");
+  }
+  if (!j.is_object() || !j.contains("frames") || !j["frames"].is_array())
+    throw Error(file.string() + ": expected {\"frames\": [{\"name\": ..., \"family\": ...}, ...]}");
+  for (auto& [name, info] : infos) info.family = "unlisted";
+  for (const auto& f : j["frames"]) {
+    if (!f.is_object() || !f.contains("name") || !f["name"].is_string())
+      throw Error(file.string() + ": every frame needs a \"name\"");
+    const auto it = infos.find(f["name"].get<std::string>());
+    if (it == infos.end()) continue;  // a frame the dataset does not hold
+    // A listed frame without a family is only in "all" (scenes.json may name scenes only).
+    it->second.family = f.contains("family") && f["family"].is_string() ? f["family"].get<std::string>() : "all";
+    if (f.contains("scene") && (f["scene"].is_string() || f["scene"].is_number()))
+      it->second.scene = f["scene"].is_string() ? f["scene"].get<std::string>() : f["scene"].dump();
+  }
+  return infos;
+}
 
 }  // namespace clutterseg::app

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -62,6 +63,13 @@ class FrameSource {
   std::optional<Camera> dataset_camera_;
   CameraOptions camera_;
 };
+
+// A frame's family and scene from DATASET/scenes.json {"frames": [{"name", "family", "scene"?}, ...]}.
+struct FrameInfo {
+  std::string family = "all", scene;
+};
+// Without a scene entry every frame is its own scene, or all frames one scene with `sequence`.
+std::map<std::string, FrameInfo> frame_infos(const fs::path& dataset, const FrameSource& source, bool sequence);
 
 // A one-line progress bar on stderr, shown only when stderr is a terminal.
 class Progress {
