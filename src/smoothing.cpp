@@ -241,19 +241,21 @@ void mean_within_band(const std::vector<const float*>& rows, const float* centre
 
 bool scene_changed(const cv::Mat& previous, const cv::Mat& next, const Params::Smoothing& params) {
   if (previous.size() != next.size()) return true;
-  // A sample of the pixels (every 4th of every 4th row) is plenty for a share.
+  // A sample of the pixels (every 4th of every 4th row of a frame that has enough) is plenty for a share.
+  const int stride = next.total() >= 64 * 64 ? 4 : 1;
   int both = 0, moved = 0;
   const auto k = static_cast<float>(params.temporal_band);
-  for (int y = 0; y < next.rows; y += 4) {
+  for (int y = 0; y < next.rows; y += stride) {
     const float* a = previous.ptr<float>(y);
     const float* b = next.ptr<float>(y);
-    for (int x = 0; x < next.cols; x += 4) {
+    for (int x = 0; x < next.cols; x += stride) {
       if (!valid_depth(a[x]) || !valid_depth(b[x])) continue;
       ++both;
       moved += std::abs(b[x] - a[x]) > k * b[x] * b[x];
     }
   }
-  return both == 0 || moved > params.scene_change_share * both;
+  // Pixels measured in one frame only are never averaged anyway: without common pixels, nothing to decide.
+  return both > 0 && moved > params.scene_change_share * both;
 }
 
 cv::Mat TemporalSmoother::make_room(const cv::Mat& next, const Params::Smoothing& params) {

@@ -106,6 +106,25 @@ TEST(Temporal, AveragesStaticNoiseAndKeepsMotion) {
   EXPECT_FLOAT_EQ(out.at<float>(10, 10), 0.9f);
 }
 
+// A folder of unrelated frames, or a cut in a video: depth of one scene must never be averaged into the
+// next. An object moving over a third of the image is the same scene and keeps the window.
+TEST(Temporal, ANewSceneEmptiesTheWindowAMovingObjectDoesNot) {
+  Params::Smoothing p;
+  TemporalSmoother t;
+  for (int i = 0; i < 3; ++i) t.push(cv::Mat(40, 40, CV_32F, cv::Scalar(1.0f)), p);
+  cv::Mat moving(40, 40, CV_32F, cv::Scalar(1.0f));
+  moving(cv::Rect(0, 0, 40, 13)).setTo(0.8f);  // a third of the pixels 20 cm closer
+  t.push(moving, p);
+  EXPECT_EQ(t.size(), 4);
+  EXPECT_FALSE(scene_changed(moving, cv::Mat(40, 40, CV_32F, cv::Scalar(1.0f)), p));
+  const cv::Mat other(40, 40, CV_32F, cv::Scalar(1.5f));  // another scene: everything 50 cm farther
+  EXPECT_TRUE(scene_changed(moving, other, p));
+  const cv::Mat out = t.push(other, p);
+  EXPECT_EQ(t.size(), 1);
+  EXPECT_FLOAT_EQ(out.at<float>(30, 30), 1.5f);
+  EXPECT_TRUE(scene_changed(other, cv::Mat(20, 20, CV_32F, cv::Scalar(1.5f)), p));  // another size
+}
+
 TEST(Normals, PlaneFacingTheCameraAndTiltedPlane) {
   Camera cam = synth::default_camera(64, 48);
   cv::Mat flat(48, 64, CV_32F, cv::Scalar(1.0f));

@@ -54,7 +54,7 @@ TEST(Quality, HandLabelledOsdFrames) {
   const Totals t = score(dev / "osd-kinect" / "depth", fs::path(CLUTTERSEG_SOURCE_DIR) / "data/handlabelled/osd-kinect/label",
                          read_camera_json(dev / "osd-kinect" / "camera.json"), false);
   ASSERT_EQ(t.frames, 5);
-  // docs/RESULTS.md, "Hand-labelled frames": F 86, tp 91, fp 21, 9 objects in merges (of 46), table in
+  // docs/RESULTS.md, "The hand-labelled regression set": F 86, tp 91, fp 21, 9 objects in merges (of 46), table in
   // objects 0.6 %; before issue 14: F 81, fp 25, 14 merged, 1.9 %.
   EXPECT_GE(t.overlap_f, 0.85);
   EXPECT_GE(t.tp, 0.89);
