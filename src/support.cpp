@@ -132,6 +132,15 @@ cv::Mat dilate_by_spans(const cv::Mat& cells, const cv::Mat& kernel) {
   return out;
 }
 
+// Points within their tolerance of the plane (a, b, c, d): Plane::distance's arithmetic in its order
+// (Eigen's dot is a*x + (b*y + c*z)), so the count is the one it gives, lane by lane.
+CLUTTERSEG_ROW_KERNEL int count_within(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                                       const float* __restrict tolerance, int n, float a, float b, float c, float d) {
+  int count = 0;
+  for (int k = 0; k < n; ++k) count += std::abs(a * x[k] + (b * y[k] + c * z[k]) + d) <= tolerance[k];
+  return count;
+}
+
 // Every stride-th valid pixel of a patch, at most about `most` of them (bounded work per patch).
 std::vector<int> sample_of(const std::vector<int>& pixels, const cv::Vec3f* pts, size_t most) {
   std::vector<int> sample;
@@ -156,11 +165,16 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
     state ^= state << 13; state ^= state >> 7; state ^= state << 17;
     return static_cast<size_t>(state % sample.size());
   };
+  // The sample's coordinates as planes: the 30 counts below read them contiguously (and vectorise).
+  std::vector<float> sx(sample.size()), sy(sample.size()), sz(sample.size());
+  for (size_t k = 0; k < sample.size(); ++k) {
+    sx[k] = pts[sample[k]][0];
+    sy[k] = pts[sample[k]][1];
+    sz[k] = pts[sample[k]][2];
+  }
   auto inliers_of = [&](const Plane& candidate) {
-    int count = 0;
-    for (size_t k = 0; k < sample.size(); ++k)
-      count += std::abs(candidate.distance(point_at(pts, sample[k]))) <= tolerance[k];
-    return count;
+    return count_within(sx.data(), sy.data(), sz.data(), tolerance.data(), static_cast<int>(sample.size()),
+                        candidate.normal.x(), candidate.normal.y(), candidate.normal.z(), candidate.offset);
   };
   int best_count = -1;
   Plane best;
