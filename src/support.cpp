@@ -507,12 +507,21 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
   const int total = static_cast<int>(assigned_labels.total()), num_patches = static_cast<int>(patches.size());
   const float a = plane.normal.x(), b = plane.normal.y(), c = plane.normal.z(), d = plane.offset;
   const auto k = static_cast<float>(params.pixel_band);
+  std::vector<std::uint8_t> table(static_cast<size_t>(num_patches) + 1, 0);
+  for (int p = 0; p < num_patches; ++p) table[static_cast<size_t>(p) + 1] = patches[static_cast<size_t>(p)].table;
   int released = 0;
+  // Only edge pixels can be released: 32 labels at a time are compared with the core labels (memcmp),
+  // and the pixels of a block that differs are looked at.
+  constexpr int kBlock = 32;
   for (int i = 0; i < total; ++i) {
+    if (i % kBlock == 0 && i + kBlock <= total && std::memcmp(lab + i, core + i, kBlock * sizeof(int)) == 0) {
+      i += kBlock - 1;
+      continue;
+    }
     const int l = lab[i];
     if (l == core[i] || l <= 0 || l > num_patches) continue;  // a core pixel, or no patch: not an edge pixel's
     const float x = pts[i][0], y = pts[i][1], z = pts[i][2];
-    if (!patches[static_cast<size_t>(l - 1)].table || a * x + b * y + c * z + d <= k * std::max(1.f, z * z)) continue;
+    if (!table[static_cast<size_t>(l)] || a * x + b * y + c * z + d <= k * std::max(1.f, z * z)) continue;
     lab[i] = 0;
     ++released;
   }
