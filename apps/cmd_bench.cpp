@@ -138,7 +138,10 @@ double thread_cpu_ms() {
 }
 
 // --load N: N child processes that spin at normal priority for the whole run (what a robot's other
-// software does to the cores), stopped by their PIDs at the end, or by the kernel if bench dies.
+// software does to the cores), stopped by their PIDs at the end, or by the kernel if bench dies. Each
+// starts its own session, as a process started from another shell does: with Linux's autogroup
+// scheduling, its own group, so bench's threads together get the cores the burners leave, not a share
+// per thread.
 class Load {
  public:
   explicit Load(int n) {
@@ -147,6 +150,7 @@ class Load {
       if (pid < 0) throw Error("bench --load: fork failed");
       if (pid == 0) {
         prctl(PR_SET_PDEATHSIG, SIGKILL);
+        setsid();
         for (;;) asm volatile("" ::: "memory");  // spin; the compiler may not drop the loop
       }
       pids_.push_back(pid);
@@ -172,7 +176,7 @@ struct Streamer {
   std::unique_ptr<Pipeline> pipe;
   std::vector<double> fps;  // one value per pass over the frames
   double cpu_s = 0, wall_s = 0;
-  size_t frames_per_pass = 0;
+  size_t frames_per_pass = 0, frames = 0;  // timed frames in all passes
 
   // Frames per second of one pass: `count` frames, cycling through `frames` (wall time from the first
   // frame in to the last result out).
@@ -207,6 +211,7 @@ struct Streamer {
     wall_s += s;
     fps.push_back(static_cast<double>(ok) / s);
     frames_per_pass = count;
+    frames += ok;
   }
 };
 
@@ -281,13 +286,14 @@ std::string report(const BenchOptions& o, const std::vector<Runner>& runners, co
     md << "\nclutterseg throughput over the stream (" << streams.front().frames_per_pass << " frames per pass, " << streams.front().fps.size()
        << " passes, configurations interleaved pass by pass; fps = frames / wall time from the first frame in to the "
           "last result out):\n\n";
-    md << "| configuration | threads | median fps | min fps | ms per frame | fps / one thread | CPU s / wall s |\n";
-    md << "|---|---:|---:|---:|---:|---:|---:|\n";
+    md << "| configuration | threads | median fps | min fps | ms per frame | fps / one thread | CPU s / wall s | CPU ms per frame |\n";
+    md << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const Streamer& st : streams) {
       const double fps = percentile(st.fps, 0.5);
       md << "| " << st.label << " | " << threads_label(st.threads) << " | " << fmt(fps) << " | "
          << fmt(*std::min_element(st.fps.begin(), st.fps.end())) << " | " << fmt(1000.0 / fps) << " | "
-         << fmt(fps / one) << "x | " << fmt(st.wall_s > 0 ? st.cpu_s / st.wall_s : NAN) << " |\n";
+         << fmt(fps / one) << "x | " << fmt(st.wall_s > 0 ? st.cpu_s / st.wall_s : NAN) << " | "
+         << fmt(st.frames > 0 ? 1000.0 * st.cpu_s / static_cast<double>(st.frames) : NAN) << " |\n";
     }
   }
   // clutterseg per stage, single- and multi-threaded side by side.
@@ -399,6 +405,7 @@ int run(const BenchOptions& o) {
     add_stream("Segmenter, frame after frame", 1, false);
     add_stream("Segmenter, frame after frame", 0, false);
     add_stream("Pipeline (frames across cores)", 0, true);
+    if (cores > 1) add_stream("Pipeline (frames across cores)", cores, true);
     // Passes of at least 30 frames (the frames cycled), so that filling and draining the pipeline is a
     // small part of a pass; as many passes as the latency runs have.
     const size_t per_pass = frames.size() * ((30 + frames.size() - 1) / frames.size());
@@ -408,6 +415,7 @@ int run(const BenchOptions& o) {
       st.pass(frames, frames.size());
       st.fps.clear();
       st.cpu_s = st.wall_s = 0;
+      st.frames = 0;
       sprog.step(st.label + " warm-up");
     }
     for (int pass = 0; pass < stream_passes; ++pass)

@@ -52,18 +52,25 @@ int runnable_tasks() {
   return running;
 }
 
-// Cores nobody else is running on, the caller's own included; re-read at most every 10 ms (a read
-// costs a few microseconds; a frame has ~10 regions).
+}  // namespace
+
 int free_cores() {
+  const int running = runnable_tasks();
+  return running < 0 ? cores() : cores() - running + 1;
+}
+
+namespace {
+
+// free_cores(), clamped to [1, cores], re-read at most every 10 ms (a read costs a few microseconds; a
+// frame has ~10 regions).
+int cached_free_cores() {
   static std::atomic<std::int64_t> read_at{std::numeric_limits<std::int64_t>::min()};
   static std::atomic<int> cached{1};
   const std::int64_t now = Clock::now().time_since_epoch().count();
   constexpr std::int64_t kRefresh = std::chrono::duration_cast<Clock::duration>(std::chrono::milliseconds(10)).count();
   std::int64_t last = read_at.load(std::memory_order_relaxed);
-  if (now - last >= kRefresh && read_at.compare_exchange_strong(last, now)) {
-    const int running = runnable_tasks();
-    cached.store(running < 0 ? cores() : std::clamp(cores() - running + 1, 1, cores()), std::memory_order_relaxed);
-  }
+  if (now - last >= kRefresh && read_at.compare_exchange_strong(last, now))
+    cached.store(std::clamp(free_cores(), 1, cores()), std::memory_order_relaxed);
   return cached.load(std::memory_order_relaxed);
 }
 
@@ -177,7 +184,7 @@ void set_threads(int threads) {
 int region_threads() {
   if (t_threads == 1 || cores() == 1) return 1;
   if (t_threads > 1) return std::min(t_threads, cores());
-  return free_cores();
+  return cached_free_cores();
 }
 
 void parallel_for_rows(int rows, const std::function<void(int, int)>& body) {

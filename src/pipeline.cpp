@@ -49,6 +49,8 @@ struct Pipeline::State {
   std::uint64_t next_start = 0;             // the next frame a worker takes
   std::uint64_t front_turn = 0;             // the frame whose smoothing runs next
   TemporalSmoother temporal;
+  int active = 0;                           // workers segmenting a frame
+  bool adaptive = true;                     // threads = 0: a second frame only on an idle core
   bool stop = false;
   mutable std::mutex m;
   std::condition_variable changed;  // any of the above moved
@@ -69,8 +71,17 @@ struct Pipeline::State {
     Segmenter segmenter(inner);
     std::unique_lock lock(m);
     for (;;) {
-      changed.wait(lock, [&] { return stop || next_start < next_seq; });
-      if (next_start >= next_seq) return;  // stopped with nothing left
+      // With the default thread count a worker takes a frame while another is busy only if a core is
+      // idle: on a loaded machine (another process running) frames go one at a time, as with one
+      // thread, and two frames do not share one core's time slices and cache. Re-checked every 2 ms.
+      auto may_start = [&] { return active == 0 || !adaptive || free_cores() >= 1; };
+      for (;;) {
+        changed.wait(lock, [&] { return stop || next_start < next_seq; });
+        if (next_start >= next_seq) return;  // stopped with nothing left
+        if (may_start()) break;
+        changed.wait_for(lock, std::chrono::milliseconds(2));
+      }
+      ++active;
       const std::shared_ptr<Slot> slot = slot_of(next_start++);
       // The smoothing, in frame order.
       changed.wait(lock, [&] { return front_turn == slot->seq; });
@@ -110,6 +121,7 @@ struct Pipeline::State {
       }
       slot->depth.release();
       slot->done = true;
+      --active;
       changed.notify_all();
     }
   }
@@ -120,6 +132,7 @@ Pipeline::Pipeline(Params params) : state_(std::make_unique<State>()) {
   if (params.keep_freed_memory) keep_freed_memory();
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   s.workers = params.threads > 0 ? params.threads : cores;
+  s.adaptive = params.threads <= 0;
   s.capacity = 2 * s.workers;  // every worker busy, and one frame each waiting
   s.params = std::move(params);
   for (int i = 0; i < s.workers; ++i) s.threads.emplace_back([&s] { s.work(); });

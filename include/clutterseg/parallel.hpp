@@ -32,4 +32,8 @@ void set_threads(int threads);
 // The threads the calling thread's next region would use (1 when it runs serially).
 int region_threads();
 
+// Cores no runnable task other than the caller uses right now (the caller's own counted as free; Linux:
+// /proc/loadavg; all cores elsewhere). 0 or less when the machine is busy.
+int free_cores();
+
 }  // namespace clutterseg
