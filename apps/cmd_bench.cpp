@@ -176,7 +176,7 @@ struct Streamer {
   std::unique_ptr<Pipeline> pipe;
   std::vector<double> fps;  // one value per pass over the frames
   double cpu_s = 0, wall_s = 0;
-  size_t frames_per_pass = 0, frames = 0;  // timed frames in all passes
+  size_t frames_per_pass = 0, timed_frames = 0;  // frames of all timed passes
 
   // Frames per second of one pass: `count` frames, cycling through `frames` (wall time from the first
   // frame in to the last result out).
@@ -211,7 +211,7 @@ struct Streamer {
     wall_s += s;
     fps.push_back(static_cast<double>(ok) / s);
     frames_per_pass = count;
-    frames += ok;
+    timed_frames += ok;
   }
 };
 
@@ -293,7 +293,7 @@ std::string report(const BenchOptions& o, const std::vector<Runner>& runners, co
       md << "| " << st.label << " | " << threads_label(st.threads) << " | " << fmt(fps) << " | "
          << fmt(*std::min_element(st.fps.begin(), st.fps.end())) << " | " << fmt(1000.0 / fps) << " | "
          << fmt(fps / one) << "x | " << fmt(st.wall_s > 0 ? st.cpu_s / st.wall_s : NAN) << " | "
-         << fmt(st.frames > 0 ? 1000.0 * st.cpu_s / static_cast<double>(st.frames) : NAN) << " |\n";
+         << fmt(st.timed_frames > 0 ? 1000.0 * st.cpu_s / static_cast<double>(st.timed_frames) : NAN) << " |\n";
     }
   }
   // clutterseg per stage, single- and multi-threaded side by side.
@@ -415,7 +415,7 @@ int run(const BenchOptions& o) {
       st.pass(frames, frames.size());
       st.fps.clear();
       st.cpu_s = st.wall_s = 0;
-      st.frames = 0;
+      st.timed_frames = 0;
       sprog.step(st.label + " warm-up");
     }
     for (int pass = 0; pass < stream_passes; ++pass)
