@@ -169,6 +169,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
         const SeedSet& other = seeds[static_cast<size_t>(neighbour)];
         for (int s = 0; s < other.count; ++s) {
           const Seed& t = other.seed[s];
+          if (s < own.count && own.seed[s].yx == t.yx) continue;  // held, in the same slot: nothing to do
           offer(t.yx, t.label);
         }
       }
