@@ -152,16 +152,13 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
       const int dx = sx - x, dy = sy - y;
       own.offer(yx, label, [&] { return dx * dx + dy * dy <= r2; }, [&] {
         if (!has_point) return static_cast<float>(dx * dx + dy * dy);
-        const cv::Vec3f d = pts[sy * width + sx] - here;
-        return d.dot(d);
+        // cv::Vec3f's difference and dot, written out: the same operations in the same order.
+        const cv::Vec3f& q = pts[sy * width + sx];
+        const float ex = q[0] - here[0], ey = q[1] - here[1], ez = q[2] - here[2];
+        return ex * ex + ey * ey + ez * ez;
       }, has_point ? d2_max : std::numeric_limits<float>::infinity());
     };
-    // Border tests only for carriers on the image border (most are inside).
-    const bool inside = x > 0 && y > 0 && x + 1 < width && y + 1 < height;
-    for (const auto& d : from) {
-      const int xx = x + d[0], yy = y + d[1];
-      if (!inside && (xx < 0 || yy < 0 || xx >= width || yy >= height)) continue;
-      const int j = c.i + d[1] * width + d[0];
+    auto visit = [&](int j, int xx, int yy) {
       const int neighbour = role[static_cast<size_t>(j)];
       if (neighbour == kSource) {
         offer(pack(xx, yy), lab[j]);
@@ -173,6 +170,16 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
           offer(t.yx, t.label);
         }
       }
+    };
+    // Most carriers are inside the image: their four neighbours need no border test (same order).
+    if (x > 0 && y > 0 && x + 1 < width && y + 1 < height) {
+      for (const auto& d : from) visit(c.i + d[1] * width + d[0], x + d[0], y + d[1]);
+      return;
+    }
+    for (const auto& d : from) {
+      const int xx = x + d[0], yy = y + d[1];
+      if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
+      visit(yy * width + xx, xx, yy);
     }
   };
   for (const Carrier& c : carriers) gather(c, std::integral_constant<int, 0>{});
