@@ -263,7 +263,7 @@ std::string report(const BenchOptions& o, const std::vector<Runner>& runners, co
   md << "### `" << command_line(o) << "`\n\n";
   md << "- date: " << utc_now() << "\n";
   md << "- machine: " << cores << " cores (nproc), " << cpu_model() << "\n";
-  md << "- load: " << (o.load > 0 ? std::to_string(o.load) + " busy process(es) at normal priority started by bench (--load)"
+  md << "- load: " << (o.load > 0 ? std::to_string(o.load) + " busy process(es) at normal priority, each in its own session, started by bench (--load)"
                                   : std::string("none started by bench")) << "; load average at the end: " << load_average() << "\n";
   md << "- frames: " << frames.size() << " of " << frames.front().depth.cols << "x" << frames.front().depth.rows
      << ", " << passes << " pass(es) timed after " << o.warmup << " warm-up frame(s) per method\n";

@@ -62,13 +62,62 @@ struct Pipeline::State {
     return nullptr;
   }
 
-  void work() {
-    set_threads(1);  // the other cores run other frames
+  static Params inner_params(const Params& params) {
     Params inner = params;
     inner.smoothing.median = false;
     inner.smoothing.temporal = false;
     inner.threads = 1;
-    Segmenter segmenter(inner);
+    return inner;
+  }
+
+  // Smooths the slot's frame in frame order, then segments it with `segmenter`; `lock` (held on entry
+  // and exit) is released while working.
+  void process(const std::shared_ptr<Slot>& slot, Segmenter& segmenter, std::unique_lock<std::mutex>& lock) {
+    // The smoothing, in frame order.
+    changed.wait(lock, [&] { return front_turn == slot->seq; });
+    cv::Mat smoothed;
+    double median_ms = 0, temporal_ms = 0;
+    const Params::Smoothing& sp = params.smoothing;
+    lock.unlock();  // the ticket alone guards the window
+    try {
+      auto t = std::chrono::steady_clock::now();
+      cv::Mat depth = checked_metres(slot->depth, slot->camera);
+      t = std::chrono::steady_clock::now();
+      if (sp.median) depth = median_depth(depth);
+      median_ms = ms_since(t);
+      t = std::chrono::steady_clock::now();
+      smoothed = !sp.temporal ? depth : sp.median ? temporal.push(std::move(depth), sp) : temporal.push(depth, sp);
+      temporal_ms = ms_since(t);
+    } catch (...) {
+      slot->error = std::current_exception();
+    }
+    lock.lock();
+    ++front_turn;
+    changed.notify_all();
+    if (!slot->error) {
+      lock.unlock();
+      try {
+        Result r = segmenter.segment(smoothed, slot->camera);
+        for (auto& [stage, ms] : r.timings_ms) {
+          if (stage == "median") ms = median_ms;
+          else if (stage == "temporal_smoothing") ms = temporal_ms;
+          else if (stage == "total") ms += median_ms + temporal_ms;
+        }
+        slot->result = std::move(r);
+      } catch (...) {
+        slot->error = std::current_exception();
+      }
+      lock.lock();
+    }
+    slot->depth.release();
+    slot->done = true;
+  }
+
+  std::unique_ptr<Segmenter> caller_segmenter;  // push()'s own, for frames it segments itself
+
+  void work() {
+    set_threads(1);  // the other cores run other frames
+    Segmenter segmenter(inner_params(params));
     std::unique_lock lock(m);
     for (;;) {
       // With the default thread count a worker takes a frame while another is busy only if a core is
@@ -82,45 +131,7 @@ struct Pipeline::State {
         changed.wait_for(lock, std::chrono::milliseconds(2));
       }
       ++active;
-      const std::shared_ptr<Slot> slot = slot_of(next_start++);
-      // The smoothing, in frame order.
-      changed.wait(lock, [&] { return front_turn == slot->seq; });
-      cv::Mat smoothed;
-      double median_ms = 0, temporal_ms = 0;
-      const Params::Smoothing& sp = params.smoothing;
-      lock.unlock();  // the ticket alone guards the window
-      try {
-        auto t = std::chrono::steady_clock::now();
-        cv::Mat depth = checked_metres(slot->depth, slot->camera);
-        t = std::chrono::steady_clock::now();
-        if (sp.median) depth = median_depth(depth);
-        median_ms = ms_since(t);
-        t = std::chrono::steady_clock::now();
-        smoothed = !sp.temporal ? depth : sp.median ? temporal.push(std::move(depth), sp) : temporal.push(depth, sp);
-        temporal_ms = ms_since(t);
-      } catch (...) {
-        slot->error = std::current_exception();
-      }
-      lock.lock();
-      ++front_turn;
-      changed.notify_all();
-      if (!slot->error) {
-        lock.unlock();
-        try {
-          Result r = segmenter.segment(smoothed, slot->camera);
-          for (auto& [stage, ms] : r.timings_ms) {
-            if (stage == "median") ms = median_ms;
-            else if (stage == "temporal_smoothing") ms = temporal_ms;
-            else if (stage == "total") ms += median_ms + temporal_ms;
-          }
-          slot->result = std::move(r);
-        } catch (...) {
-          slot->error = std::current_exception();
-        }
-        lock.lock();
-      }
-      slot->depth.release();
-      slot->done = true;
+      process(slot_of(next_start++), segmenter, lock);
       --active;
       changed.notify_all();
     }
@@ -156,6 +167,15 @@ std::uint64_t Pipeline::push(const cv::Mat& depth, const Camera& camera) {
   slot->depth = depth;
   slot->camera = camera;
   s.slots.push_back(slot);
+  // Nothing in flight and no idle core for a second frame (another process runs): the caller segments
+  // the frame itself, as Segmenter::segment would - no hand-over to a worker, its memory stays warm.
+  if (s.adaptive && s.active == 0 && s.next_start + 1 == s.next_seq && free_cores() <= 1) {
+    if (!s.caller_segmenter) s.caller_segmenter = std::make_unique<Segmenter>(State::inner_params(s.params));
+    ++s.active;
+    ++s.next_start;
+    s.process(slot, *s.caller_segmenter, lock);
+    --s.active;
+  }
   s.changed.notify_all();
   return slot->seq;
 }
