@@ -21,6 +21,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -84,10 +85,17 @@ struct Job {
 
   // Claims and runs blocks until none is left; a claim past the end never touches `body`, so a late
   // helper holding this job after the caller returned does nothing.
+  std::exception_ptr error;  // the first block's exception, rethrown by the caller after every block ended
+
   void work() {
     for (int b = next.fetch_add(1); b < blocks; b = next.fetch_add(1)) {
       const int begin = b * block;
-      (*body)(begin, std::min(rows, begin + block));
+      try {
+        (*body)(begin, std::min(rows, begin + block));
+      } catch (...) {
+        std::lock_guard lock(m);
+        if (!error) error = std::current_exception();
+      }
       if (finished.fetch_add(1) + 1 == blocks) {
         std::lock_guard lock(m);
         cv.notify_all();
@@ -126,8 +134,11 @@ class Pool {
       std::unique_lock lock(job->m);
       job->cv.wait(lock, [&] { return job->finished.load() >= job->blocks; });
     }
-    std::lock_guard lock(m_);
-    job_.reset();  // helpers that wake now see no job
+    {
+      std::lock_guard lock(m_);
+      job_.reset();  // helpers that wake now see no job
+    }
+    if (job->error) std::rethrow_exception(job->error);  // the body is not in use any more
     return true;
   }
 

@@ -45,6 +45,18 @@ TEST(Threads, EveryRowOnceForAnyThreadCountAndConcurrentCallers) {
   EXPECT_EQ(region_threads(), 1);
 }
 
+TEST(Threads, AnExceptionInARowReachesTheCallerAndThePoolStaysUsable) {
+  set_threads(2);
+  EXPECT_THROW(parallel_for_rows(400, [](int begin, int) {
+                 if (begin == 384) throw Error("row failed");
+               }),
+               Error);
+  std::atomic<int> rows{0};
+  parallel_for_rows(400, [&](int begin, int end) { rows += end - begin; });
+  EXPECT_EQ(rows.load(), 400);
+  set_threads(0);
+}
+
 TEST(Threads, PipelineGivesSegmentersResultsInOrderAndSurvivesABadFrame) {
   // A moving object over a static table at 320x240 (cheap), so that the temporal window matters.
   const Camera camera = synth::default_camera(320, 240);
