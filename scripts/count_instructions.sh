@@ -20,7 +20,8 @@ import re, sys
 # Inclusive cost of every stage function as called from the pipeline, divided by the pipeline calls.
 stages = ["median_depth", "TemporalSmoother::push", "depth_to_points", "compute_normals", "normal_edge_value",
           "edge_mask", "extract_patches", "assign_edge_pixels", "cut_free_pairs", "coplanar_pairs",
-          "curvature_links", "cut_graph", "assign_remaining", "describe_objects", "find_support", "split_support"]
+          "curvature_links", "cut_graph", "assign_remaining", "describe_objects", "find_support_plane", "cut_off_table",
+          "split_at_planes", "release_from_table", "classify_junctions", "classify_objects", "support_of"]
 cost, inside = {}, False
 for line in sys.stdin:
     m = re.match(r"\s*([\d,]+) \([^)]*\)\s+(\*|>)\s+\S*?clutterseg::([\w:]+)\(.*?\((\d+)x\)", line)
@@ -30,7 +31,9 @@ for line in sys.stdin:
         total = int(line.split()[0].replace(",", ""))
     if inside and m and m.group(2) == ">" and m.group(3) in stages:
         cost[m.group(3)] = (int(m.group(1).replace(",", "")), int(m.group(4)))
-calls = max((c for _, c in cost.values()), default=1)
+# Per frame: divided by the calls of compute_normals, which runs once per frame (extract_patches runs
+# again after a split).
+calls = cost["compute_normals"][1] if "compute_normals" in cost else max((c for _, c in cost.values()), default=1)
 print("instructions per frame [million], mean over %d pipeline calls" % calls)
 for s in stages:
     if s in cost: print("  %-24s %8.2f" % (s, cost[s][0] / calls / 1e6))

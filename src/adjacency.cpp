@@ -53,12 +53,16 @@ struct SeedSet {
   // Offers a seed: keeps the nearest seed per label and the kMaxSeeds nearest labels. Neighbours mostly
   // pass on a seed this set already holds; that case returns before any distance is computed.
   // `distance2` gives d2 for the candidate; seeds at `limit` or farther are not kept.
-  template <typename Distance2>
-  void offer(std::uint32_t yx, int label, Distance2 distance2, float limit) {
+  // `within` tells whether the candidate is within the search radius: asked only for a seed not held
+  // already (a held seed passed it, and a pixel has one label, so equal yx means the same seed).
+  template <typename Within, typename Distance2>
+  void offer(std::uint32_t yx, int label, Within within, Distance2 distance2, float limit) {
+    for (int i = 0; i < count; ++i)
+      if (seed[i].yx == yx) return;
+    if (!within()) return;
     int slot = -1;
     for (int i = 0; i < count; ++i)
       if (seed[i].label == label) {
-        if (seed[i].yx == yx) return;
         slot = i;
         break;
       }
@@ -143,29 +147,39 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     SeedSet& own = seeds[static_cast<size_t>(role[static_cast<size_t>(c.i)])];
     const cv::Vec3f here = pts[c.i];
     const bool has_point = valid_point(here);
-    auto offer = [&](int sx, int sy, int label) {
+    auto offer = [&](std::uint32_t yx, int label) {
+      const int sx = static_cast<int>(yx & 0xffff), sy = static_cast<int>(yx >> 16);
       const int dx = sx - x, dy = sy - y;
-      if (dx * dx + dy * dy > r2) return;
-      own.offer(pack(sx, sy), label, [&] {
+      own.offer(yx, label, [&] { return dx * dx + dy * dy <= r2; }, [&] {
         if (!has_point) return static_cast<float>(dx * dx + dy * dy);
-        const cv::Vec3f d = pts[sy * width + sx] - here;
-        return d.dot(d);
+        // cv::Vec3f's difference and dot, written out: the same operations in the same order.
+        const cv::Vec3f& q = pts[sy * width + sx];
+        const float ex = q[0] - here[0], ey = q[1] - here[1], ez = q[2] - here[2];
+        return ex * ex + ey * ey + ez * ez;
       }, has_point ? d2_max : std::numeric_limits<float>::infinity());
     };
-    for (const auto& d : from) {
-      const int xx = x + d[0], yy = y + d[1];
-      if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
-      const int j = yy * width + xx;
+    auto visit = [&](int j, int xx, int yy) {
       const int neighbour = role[static_cast<size_t>(j)];
       if (neighbour == kSource) {
-        offer(xx, yy, lab[j]);
+        offer(pack(xx, yy), lab[j]);
       } else if (neighbour >= 0) {
         const SeedSet& other = seeds[static_cast<size_t>(neighbour)];
         for (int s = 0; s < other.count; ++s) {
           const Seed& t = other.seed[s];
-          offer(static_cast<int>(t.yx & 0xffff), static_cast<int>(t.yx >> 16), t.label);
+          if (s < own.count && own.seed[s].yx == t.yx) continue;  // held, in the same slot: nothing to do
+          offer(t.yx, t.label);
         }
       }
+    };
+    // Most carriers are inside the image: their four neighbours need no border test (same order).
+    if (x > 0 && y > 0 && x + 1 < width && y + 1 < height) {
+      for (const auto& d : from) visit(c.i + d[1] * width + d[0], x + d[0], y + d[1]);
+      return;
+    }
+    for (const auto& d : from) {
+      const int xx = x + d[0], yy = y + d[1];
+      if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
+      visit(yy * width + xx, xx, yy);
     }
   };
   for (const Carrier& c : carriers) gather(c, std::integral_constant<int, 0>{});

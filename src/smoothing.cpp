@@ -18,10 +18,13 @@ cv::Mat depth_to_metres(const cv::Mat& depth, const Camera& camera) {
   if (depth.type() == CV_16UC1) {
     depth.convertTo(out, CV_32F, camera.depth_unit_m);
   } else if (depth.type() == CV_32FC1) {
-    depth.copyTo(out);
-    out.forEach<float>([](float& z, const int*) {
-      if (!std::isfinite(z) || z <= 0) z = 0;
-    });
+    // A plain loop (Mat::forEach computes each pixel's position: ~5x slower); the Pipeline's workers
+    // pass every smoothed frame through here again.
+    for (int y = 0; y < depth.rows; ++y) {
+      const float* in = depth.ptr<float>(y);
+      float* o = out.ptr<float>(y);
+      for (int x = 0; x < depth.cols; ++x) o[x] = std::isfinite(in[x]) && in[x] > 0 ? in[x] : 0.f;
+    }
   } else {
     throw Error("depth must be single-channel uint16 or float32");
   }

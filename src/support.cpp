@@ -132,6 +132,15 @@ cv::Mat dilate_by_spans(const cv::Mat& cells, const cv::Mat& kernel) {
   return out;
 }
 
+// Points within their tolerance of the plane (a, b, c, d): Plane::distance's arithmetic in its order
+// (Eigen's dot is a*x + (b*y + c*z)), so the count is the one it gives, lane by lane.
+CLUTTERSEG_ROW_KERNEL int count_within(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                                       const float* __restrict tolerance, int n, float a, float b, float c, float d) {
+  int count = 0;
+  for (int k = 0; k < n; ++k) count += std::abs(a * x[k] + (b * y[k] + c * z[k]) + d) <= tolerance[k];
+  return count;
+}
+
 // Every stride-th valid pixel of a patch, at most about `most` of them (bounded work per patch).
 std::vector<int> sample_of(const std::vector<int>& pixels, const cv::Vec3f* pts, size_t most) {
   std::vector<int> sample;
@@ -156,11 +165,16 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
     state ^= state << 13; state ^= state >> 7; state ^= state << 17;
     return static_cast<size_t>(state % sample.size());
   };
+  // The sample's coordinates as planes: the 30 counts below read them contiguously (and vectorise).
+  std::vector<float> sx(sample.size()), sy(sample.size()), sz(sample.size());
+  for (size_t k = 0; k < sample.size(); ++k) {
+    sx[k] = pts[sample[k]][0];
+    sy[k] = pts[sample[k]][1];
+    sz[k] = pts[sample[k]][2];
+  }
   auto inliers_of = [&](const Plane& candidate) {
-    int count = 0;
-    for (size_t k = 0; k < sample.size(); ++k)
-      count += std::abs(candidate.distance(point_at(pts, sample[k]))) <= tolerance[k];
-    return count;
+    return count_within(sx.data(), sy.data(), sz.data(), tolerance.data(), static_cast<int>(sample.size()),
+                        candidate.normal.x(), candidate.normal.y(), candidate.normal.z(), candidate.offset);
   };
   int best_count = -1;
   Plane best;
@@ -493,12 +507,21 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
   const int total = static_cast<int>(assigned_labels.total()), num_patches = static_cast<int>(patches.size());
   const float a = plane.normal.x(), b = plane.normal.y(), c = plane.normal.z(), d = plane.offset;
   const auto k = static_cast<float>(params.pixel_band);
+  std::vector<std::uint8_t> table(static_cast<size_t>(num_patches) + 1, 0);
+  for (int p = 0; p < num_patches; ++p) table[static_cast<size_t>(p) + 1] = patches[static_cast<size_t>(p)].table;
   int released = 0;
+  // Only edge pixels can be released: 32 labels at a time are compared with the core labels (memcmp),
+  // and the pixels of a block that differs are looked at.
+  constexpr int kBlock = 32;
   for (int i = 0; i < total; ++i) {
+    if (i % kBlock == 0 && i + kBlock <= total && std::memcmp(lab + i, core + i, kBlock * sizeof(int)) == 0) {
+      i += kBlock - 1;
+      continue;
+    }
     const int l = lab[i];
     if (l == core[i] || l <= 0 || l > num_patches) continue;  // a core pixel, or no patch: not an edge pixel's
     const float x = pts[i][0], y = pts[i][1], z = pts[i][2];
-    if (!patches[static_cast<size_t>(l - 1)].table || a * x + b * y + c * z + d <= k * std::max(1.f, z * z)) continue;
+    if (!table[static_cast<size_t>(l)] || a * x + b * y + c * z + d <= k * std::max(1.f, z * z)) continue;
     lab[i] = 0;
     ++released;
   }

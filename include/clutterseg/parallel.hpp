@@ -1,5 +1,6 @@
-// The one threading helper: rows of an image in parallel (OpenMP when available). Work per row must be
-// independent so that the output is identical for any thread count.
+// The one threading helper: rows of an image in parallel (a small pool with sleeping helpers; no
+// OpenMP runtime). Work per row must be independent so that the output is identical for any thread
+// count. Cross-frame parallelism (throughput) is the Pipeline (pipeline.hpp).
 #pragma once
 
 #include <functional>
@@ -24,7 +25,15 @@ namespace clutterseg {
 
 void parallel_for_rows(int rows, const std::function<void(int begin, int end)>& body);
 
-// Sets the thread count for parallel_for_rows (0 = all cores).
+// Sets the calling thread's thread count for parallel_for_rows: 1 = serial, N = up to N threads,
+// 0 (the default) = as many as there are idle cores at each region (one when the machine is busy).
 void set_threads(int threads);
+
+// The threads the calling thread's next region would use (1 when it runs serially).
+int region_threads();
+
+// Cores no runnable task other than the caller uses right now (the caller's own counted as free; Linux:
+// /proc/loadavg; all cores elsewhere). 0 or less when the machine is busy.
+int free_cores();
 
 }  // namespace clutterseg
