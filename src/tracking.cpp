@@ -139,8 +139,10 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
       const int t = track_of_prev[static_cast<size_t>(p.a)], j = p.b - 1;
       if (t < 0) continue;
       const Track& track = tracks_[static_cast<size_t>(t)];
+      // A quarter of the larger diagonal: partial occlusion moves a centroid that much; an object that
+      // moved off and uncovered another one leaves its old pixels to an object farther away.
       const float diag = std::max(track.diagonal, extents[static_cast<size_t>(j)].norm());
-      if (distance(track, j) > reach(track) + 0.5f * diag) continue;
+      if (distance(track, j) > reach(track) + 0.25f * diag) continue;
       const double iou = p.count / static_cast<double>(area_prev[static_cast<size_t>(p.a)] + area_cur[static_cast<size_t>(p.b)] - p.count);
       candidates.push_back({iou, t, j});
     }
@@ -161,17 +163,50 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
   }
   const auto share = [&](int count, int area) { return area > 0 && count > params_.merge_share * area; };
 
-  // 2) Merges: an unmatched previous object inside a current object that kept another id.
+  // 2) Merges: an unmatched previous object inside a current object that kept another id: most of its
+  //    pixels, or (when it moves) its predicted centroid inside that object's box. The table and the
+  //    background host nothing (an object lifted away is gone, not merged into the table).
+  const auto can_host = [&](int j) {
+    const Object& o = objects[static_cast<size_t>(j)];
+    return !o.support && !o.background && track_of[static_cast<size_t>(j)] >= 0;
+  };
+  const auto inside_box = [&](const Eigen::Vector3f& p, int j) {
+    const OrientedBox& box = objects[static_cast<size_t>(j)].box;
+    const Eigen::Vector3f local = box.axes.transpose() * (p - box.center);
+    return (local.cwiseAbs().array() <= (0.5f * box.extents).array() + 0.01f).all();
+  };
   for (int a = 1; a <= mp; ++a) {
     const int t = track_of_prev[static_cast<size_t>(a)];
+    if (t < 0 || object_of[static_cast<size_t>(t)] >= 0) continue;
     const Overlap& best = best_of_prev[static_cast<size_t>(a)];
-    if (t < 0 || object_of[static_cast<size_t>(t)] >= 0 || best.count == 0 || !share(best.count, area_prev[static_cast<size_t>(a)]))
-      continue;
-    const int host = track_of[static_cast<size_t>(best.b - 1)];
-    if (host < 0) continue;
+    int j = best.count > 0 && share(best.count, area_prev[static_cast<size_t>(a)]) && can_host(best.b - 1) ? best.b - 1 : -1;
+    if (j < 0) {
+      const Eigen::Vector3f p = predicted(tracks_[static_cast<size_t>(t)]);
+      float nearest = 0;
+      for (int k = 0; k < m; ++k) {
+        if (!can_host(k) || !inside_box(p, k)) continue;
+        const float d = (objects[static_cast<size_t>(k)].centroid - p).norm();
+        if (j < 0 || d < nearest) j = k, nearest = d;
+      }
+    }
+    if (j < 0) continue;
+    const int host = track_of[static_cast<size_t>(j)];
     Track& track = tracks_[static_cast<size_t>(t)];
-    if (track.split_from == tracks_[static_cast<size_t>(host)].id) retired[static_cast<size_t>(t)] = 1;  // rejoined
-    else track.merged_into = tracks_[static_cast<size_t>(host)].id;
+    Track& hosting = tracks_[static_cast<size_t>(host)];
+    if (track.split_from == hosting.id) {  // a fragment back in the object it split from: dropped
+      retired[static_cast<size_t>(t)] = 1;
+    } else if (track.pixels > hosting.pixels) {
+      // The merged object carries the id of the larger object (as last seen alone): the one it mostly
+      // shows. The other becomes its guest, with the guests it had.
+      for (int g = 0; g < nt; ++g)
+        if (tracks_[static_cast<size_t>(g)].merged_into == hosting.id && object_of[static_cast<size_t>(g)] < 0)
+          tracks_[static_cast<size_t>(g)].merged_into = track.id;
+      hosting.merged_into = track.id;
+      object_of[static_cast<size_t>(host)] = -1;
+      assign(t, j);
+    } else {
+      track.merged_into = hosting.id;
+    }
   }
 
   // A remembered track may take object j: near its predicted centroid, and no larger than it was.
@@ -195,6 +230,11 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
   std::vector<int> guests;  // merged tracks not matched by overlap
   for (int t = 0; t < nt; ++t)
     if (tracks_[static_cast<size_t>(t)].merged_into != 0 && free_track(t)) guests.push_back(t);
+  const auto overlaps = [&](int a, int j) {  // previous object a and current object j share grid pixels
+    const auto it = std::lower_bound(pairs.begin(), pairs.end(), Overlap{a, j + 1, 0},
+                                     [](const Overlap& x, const Overlap& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+    return it != pairs.end() && it->a == a && it->b == j + 1;
+  };
   for (int a = 1; a <= mp && !guests.empty(); ++a) {
     const int host = track_of_prev[static_cast<size_t>(a)];
     if (host < 0 || object_of[static_cast<size_t>(host)] < 0) continue;
@@ -202,8 +242,9 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
     for (int t : guests)
       if (tracks_[static_cast<size_t>(t)].merged_into == tracks_[static_cast<size_t>(host)].id && free_track(t)) claimants.push_back(t);
     if (claimants.size() < 2) continue;
+    // Parts: the host's match and every unmatched object that shares pixels with the host's region.
     for (int j : order)
-      if (part_of(j) == a && (track_of[static_cast<size_t>(j)] < 0 || track_of[static_cast<size_t>(j)] == host)) parts.push_back(j);
+      if (track_of[static_cast<size_t>(j)] == host || (track_of[static_cast<size_t>(j)] < 0 && overlaps(a, j))) parts.push_back(j);
     if (parts.size() < 2) continue;
     struct Candidate {
       float d;
