@@ -282,8 +282,11 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
       for (int t = 0; t < nt; ++t)
         if (free_track(t) && fits(tracks_[static_cast<size_t>(t)], j)) candidates.push_back({distance(tracks_[static_cast<size_t>(t)], j), t, j});
     }
-    std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
-      return x.d != y.d ? x.d < y.d : x.t != y.t ? x.t < y.t : x.j < y.j;
+    // Objects seen in the previous frame first, then the longer gone: a remembered object never takes
+    // the place of one that was just there.
+    std::sort(candidates.begin(), candidates.end(), [&](const Candidate& x, const Candidate& y) {
+      const bool xr = unseen(tracks_[static_cast<size_t>(x.t)]) == 1, yr = unseen(tracks_[static_cast<size_t>(y.t)]) == 1;
+      return xr != yr ? xr : x.d != y.d ? x.d < y.d : x.t != y.t ? x.t < y.t : x.j < y.j;
     });
     for (const Candidate& c : candidates)
       if (object_of[static_cast<size_t>(c.t)] < 0 && track_of[static_cast<size_t>(c.j)] < 0) assign(c.t, c.j);
@@ -312,11 +315,17 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
     const int j = object_of[static_cast<size_t>(t)];
     if (j < 0) continue;
     track.merged_into = 0;
+    const Object& o = objects[static_cast<size_t>(j)];
     if (std::find(guest_hosts.begin(), guest_hosts.end(), track.id) != guest_hosts.end()) {
+      // Hosting: its own position moves with the merged object (a carried pair), its size stays.
+      if (track.hosting) track.centroid += o.centroid - track.seen;
+      track.hosting = true;
+      track.seen = o.centroid;
       track.last_seen = frame_;
       continue;
     }
-    const Object& o = objects[static_cast<size_t>(j)];
+    track.hosting = false;
+    track.seen = o.centroid;
     const int gap = unseen(track);
     const bool steady = std::abs(o.pixel_count - track.pixels) < kSteadyShare * std::max(o.pixel_count, track.pixels);
     if (steady && track.merged_into == 0) {
@@ -348,7 +357,7 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
     track.id = new_id();
     track.first_frame = track.last_seen = frame_;
     track.split_from = split_from[static_cast<size_t>(j)];
-    track.centroid = o.centroid;
+    track.centroid = track.seen = o.centroid;
     track.box = o.box;
     track.extents = extents[static_cast<size_t>(j)];
     track.diagonal = track.extents.norm();

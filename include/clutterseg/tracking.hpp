@@ -57,6 +57,8 @@ class Tracker {
     int merged_into = 0, split_from = 0;
     int pixels = 0;
     Eigen::Vector3f centroid = Eigen::Vector3f::Zero(), velocity = Eigen::Vector3f::Zero();
+    Eigen::Vector3f seen = Eigen::Vector3f::Zero();  // centroid of the object that last carried its id
+    bool hosting = false;                            // carried the id of a merge in the last frame seen
     Eigen::Vector3f extents = Eigen::Vector3f::Zero();  // box extents, largest first
     OrientedBox box;
     float diagonal = 0;
