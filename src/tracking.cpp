@@ -20,6 +20,9 @@ constexpr float kSizeFactor = 1.5f, kSizeSlack = 0.02f;
 // Velocity is learnt only while an object's pixel count changes less than this share between frames;
 // beyond that its centroid moves because it is being occluded or revealed, not because it moves.
 constexpr float kSteadyShare = 0.3f;
+// The gates allow for a centroid moved by occlusion, a share of the object's box diagonal, but no more
+// than this [m]: a box stretched by a few stray pixels must not open the gate across the table.
+constexpr float kMaxHalfDiagonal = 0.1f;
 
 Eigen::Vector3f sorted_extents(const OrientedBox& box) {
   Eigen::Vector3f e = box.extents;
@@ -142,7 +145,7 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
       // A quarter of the larger diagonal: partial occlusion moves a centroid that much; an object that
       // moved off and uncovered another one leaves its old pixels to an object farther away.
       const float diag = std::max(track.diagonal, extents[static_cast<size_t>(j)].norm());
-      if (distance(track, j) > reach(track) + 0.25f * diag) continue;
+      if (distance(track, j) > reach(track) + std::min(0.25f * diag, kMaxHalfDiagonal)) continue;
       const double iou = p.count / static_cast<double>(area_prev[static_cast<size_t>(p.a)] + area_cur[static_cast<size_t>(p.b)] - p.count);
       candidates.push_back({iou, t, j});
     }
@@ -214,7 +217,7 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
     const Eigen::Vector3f& e = extents[static_cast<size_t>(j)];
     for (int k = 0; k < 3; ++k)
       if (e[k] > kSizeFactor * t.extents[k] + kSizeSlack) return false;
-    return distance(t, j) <= reach(t) + 0.5f * t.diagonal;
+    return distance(t, j) <= reach(t) + std::min(0.5f * t.diagonal, kMaxHalfDiagonal);
   };
   const auto free_track = [&](int t) { return object_of[static_cast<size_t>(t)] < 0 && !retired[static_cast<size_t>(t)]; };
 
@@ -282,11 +285,8 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
       for (int t = 0; t < nt; ++t)
         if (free_track(t) && fits(tracks_[static_cast<size_t>(t)], j)) candidates.push_back({distance(tracks_[static_cast<size_t>(t)], j), t, j});
     }
-    // Objects seen in the previous frame first, then the longer gone: a remembered object never takes
-    // the place of one that was just there.
-    std::sort(candidates.begin(), candidates.end(), [&](const Candidate& x, const Candidate& y) {
-      const bool xr = unseen(tracks_[static_cast<size_t>(x.t)]) == 1, yr = unseen(tracks_[static_cast<size_t>(y.t)]) == 1;
-      return xr != yr ? xr : x.d != y.d ? x.d < y.d : x.t != y.t ? x.t < y.t : x.j < y.j;
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+      return x.d != y.d ? x.d < y.d : x.t != y.t ? x.t < y.t : x.j < y.j;
     });
     for (const Candidate& c : candidates)
       if (object_of[static_cast<size_t>(c.t)] < 0 && track_of[static_cast<size_t>(c.j)] < 0) assign(c.t, c.j);
@@ -337,7 +337,10 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
     track.merged_into = 0;
     track.centroid = o.centroid;
     track.box = o.box;
-    track.extents = extents[static_cast<size_t>(j)];
+    // An object that shrank by more than the steady share is being hidden: it keeps the size it had, so
+    // that it can come back whole.
+    const bool shrinking = o.pixel_count < (1 - kSteadyShare) * track.pixels;
+    track.extents = shrinking ? track.extents.cwiseMax(extents[static_cast<size_t>(j)]) : extents[static_cast<size_t>(j)];
     track.diagonal = track.extents.norm();
     track.pixels = o.pixel_count;
     track.last_seen = frame_;
