@@ -41,11 +41,11 @@ TEST(TrackingSequence, PickAndPlaceRemovesCarriesAndSlidesObjectsWithTheirIds) {
   for (const auto& o : synth::generate_scene("pick-and-place", 5, 59, camera).objects) ids_at_end.insert(o.id);
   EXPECT_EQ(ids_at_start, (std::set<int>{1, 2, 3, 4, 5}));
   EXPECT_EQ(ids_at_end, (std::set<int>{1, 2, 4}));  // 3 and 5 were lifted away; their ids are not reused
-  const auto pose = [&](int frame, int id) {
+  const auto pose = [&](int frame, int id) -> Eigen::Vector3d {
     for (const auto& o : synth::generate_scene("pick-and-place", 5, frame, camera).objects)
       if (o.id == id) return o.pose.translation();
     ADD_FAILURE() << "no object " << id << " in frame " << frame;
-    return Eigen::Vector3d(Eigen::Vector3d::Zero());
+    return Eigen::Vector3d::Zero();
   };
   EXPECT_GT((pose(59, 4) - pose(0, 4)).norm(), 0.25);  // carried and put down elsewhere
   EXPECT_NEAR(pose(59, 4).z(), pose(0, 4).z(), 1e-9);   // resting again
@@ -54,12 +54,12 @@ TEST(TrackingSequence, PickAndPlaceRemovesCarriesAndSlidesObjectsWithTheirIds) {
   bool held = false;
   for (const auto& o : synth::generate_scene("pick-and-place", 5, 20, camera).objects) held = held || (o.id == 4 && o.held);
   EXPECT_TRUE(held);
-  // The camera sways a little, by at most 2 mm a frame.
+  // The camera sways a little, by at most 2.5 mm a frame.
   for (int frame = 1; frame < 60; frame += 7) {
     const double step = (synth::generate_scene("pick-and-place", 5, frame, camera).eye -
                          synth::generate_scene("pick-and-place", 5, frame - 1, camera).eye).norm();
     EXPECT_GT(step, 0.0);
-    EXPECT_LT(step, 0.002);
+    EXPECT_LT(step, 0.0025);
   }
 }
 

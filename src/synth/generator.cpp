@@ -582,7 +582,7 @@ GeneratedScene generate_scene(const std::string& preset, std::uint64_t seed, int
   add_background(out.scene, lay, background_rng);
   if (pick) {
     animate_pick_and_place(items, lay, frame);
-    // The camera sways by up to 1.5 cm sideways and 1 cm up and down (at most 1.6 mm per frame).
+    // The camera sways by up to 1.5 cm sideways and 1 cm up and down (at most 2.2 mm per frame).
     const double f = std::clamp(frame, 0, 59);
     const Vector3d across(lay.across.x(), lay.across.y(), 0);
     out.eye += 0.015 * std::sin(2 * M_PI * f / 60) * across + 0.01 * std::sin(2 * M_PI * f / 40) * Vector3d::UnitZ();
