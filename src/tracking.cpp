@@ -10,9 +10,10 @@ namespace clutterseg {
 
 namespace {
 
-// Overlap is counted on every kGrid-th pixel of every kGrid-th row: a quarter of the pixels gives the
-// same matches (objects are hundreds of pixels) at a quarter of the cost.
-constexpr int kGrid = 2;
+// Overlap is counted on every grid-th pixel of every grid-th row, a 160-column grid whatever the
+// resolution (every 4th at 640x480, every 2nd at 320x240): the smallest objects still cover a dozen
+// samples, and the tracker reads a sixteenth of a VGA frame.
+int grid_step(int cols) { return std::max(1, cols / 160); }
 
 // A part of an object is never much larger than the object: a return whose box exceeds the remembered
 // one by more than this factor plus kSizeSlack along a sorted axis is another object.
@@ -68,19 +69,20 @@ std::vector<HiddenObject> Tracker::update(cv::Mat& labels, std::vector<Object>& 
   const int m = static_cast<int>(objects.size());
   const int mp = static_cast<int>(previous_ids_.size());
 
-  // 1) Pixel overlap of previous and current objects on the grid, as run-length counted pairs.
-  const int gw = (labels.cols + kGrid - 1) / kGrid, gh = (labels.rows + kGrid - 1) / kGrid;
+  // Pixel overlap of previous and current objects on the grid, as run-length counted pairs.
+  const int stride = grid_step(labels.cols);
+  const int gw = (labels.cols + stride - 1) / stride, gh = (labels.rows + stride - 1) / stride;
   std::vector<int> grid(static_cast<size_t>(gw) * static_cast<size_t>(gh));
   const bool have_previous = previous_grid_.size() == grid.size();
   std::vector<Overlap> runs;
   {
     Overlap run;
     for (int gy = 0; gy < gh; ++gy) {
-      const int* lab = labels.ptr<int>(gy * kGrid);
+      const int* lab = labels.ptr<int>(gy * stride);
       int* cur = grid.data() + static_cast<size_t>(gy) * static_cast<size_t>(gw);
       const int* prev = have_previous ? previous_grid_.data() + static_cast<size_t>(gy) * static_cast<size_t>(gw) : nullptr;
       for (int gx = 0; gx < gw; ++gx) {
-        const int raw = lab[gx * kGrid];
+        const int raw = lab[gx * stride];
         const int b = raw > 0 && raw <= m ? raw : 0;
         const int a = prev ? prev[gx] : 0;
         cur[gx] = b;

@@ -21,17 +21,18 @@ struct HiddenObject {
   OrientedBox box;            // its box when last seen
 };
 
-// Frame-to-frame matching of objects (docs/TRACKING.md). Per frame, in this order:
+// Frame-to-frame matching of objects (docs/TRACKING.md, rules 1-5). Per frame, in this order:
 //  1. overlap: pairs (object of the previous frame, object of this frame) that share pixels, on a grid of
-//     every second pixel, by IoU, greatest first, within a 3D gate around the track's predicted centroid;
-//  2. merge: an unmatched object of the previous frame most of whose pixels lie in one object that kept
-//     another id is merged into it (hidden, merged_into; listed in the host's Object::merged_with);
-//  3. split: an unmatched object most of whose pixels were one previous object that kept its id is a
-//     split part: it takes back an id merged into that object when its 3D position fits, else a new id
-//     with Object::split_from; a part that merges back into the object it split from is dropped;
+//     160 columns, by IoU, greatest first, within a 3D gate around the track's predicted centroid;
+//  2. merge: an unmatched previous object mostly inside (or, moving, with its predicted centroid inside
+//     the box of) an object that kept another id is merged into it; the merged object carries the larger
+//     one's id (Object::merged_with, HiddenObject::merged_into); the table and background host nothing;
+//  3. split: a host that comes apart gives its parts to itself and its guests by 3D distance; another
+//     unmatched part of an object that kept its id gets a new id with Object::split_from, dropped when it
+//     merges back;
 //  4. return: the rest are matched to remembered objects by 3D distance to the predicted centroid
 //     (constant velocity), nearest first, gate growing with sqrt(frames unseen), no larger than the
-//     remembered box allows;
+//     remembered object;
 //  5. new: every object still unmatched gets an id never used in the stream (ids wrap at max_id, skipping
 //     ids still in use).
 class Tracker {
