@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 
+#include "clutterseg/objects.hpp"
 #include "clutterseg/tracking.hpp"
 #include "clutterseg/tracking_metrics.hpp"
 
@@ -304,6 +305,24 @@ TEST(TrackingScores, AWeakOverlapIsNoMatch) {
   EXPECT_EQ(scorer.scores().matched, 0);
   EXPECT_EQ(scorer.scores().false_positives, 1);
   EXPECT_THROW(scorer.add(gt, cv::Mat(10, 10, CV_32S, cv::Scalar(0))), Error);
+}
+
+TEST(Tracking, TheObjectsOnlyViewKeepsTrackedIds) {
+  cv::Mat labels(4, 3, CV_32S, cv::Scalar(0));
+  labels.row(0).setTo(3);
+  labels.row(1).setTo(7);
+  labels.row(2).setTo(9);
+  std::vector<Object> objects(3);
+  objects[0].id = 3;
+  objects[1].id = 7;
+  objects[1].support = true;
+  objects[2].id = 9;
+  const cv::Mat kept = objects_only(labels, objects, true), renumbered = objects_only(labels, objects);
+  EXPECT_EQ(kept.at<int>(0, 0), 3);
+  EXPECT_EQ(kept.at<int>(1, 0), 0);
+  EXPECT_EQ(kept.at<int>(2, 0), 9);
+  EXPECT_EQ(renumbered.at<int>(0, 0), 1);
+  EXPECT_EQ(renumbered.at<int>(2, 0), 2);
 }
 
 TEST(Tracking, RejectsLabelsThatAreNotInt32) {
