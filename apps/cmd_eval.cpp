@@ -134,6 +134,7 @@ using MethodFactory = std::function<Method()>;
 void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord& run, EvalReport& report) {
   Method method = make();
   std::string scene = ev.source.size() > 0 ? ev.infos.at(ev.source.name(0)).scene : "";
+  TrackingScorer tracking;  // per scene
   const bool fill_gallery = report.gallery.empty();
   std::vector<std::pair<std::string, std::pair<double, int>>> stage_sums;
   Progress progress("eval " + run.label, ev.source.size());
@@ -146,6 +147,8 @@ void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord&
     if (rec.scene != scene) {
       method = make();
       scene = rec.scene;
+      run.tracking += tracking.scores();
+      tracking = TrackingScorer();
     }
     try {
       const Frame frame = ev.source.load(i);
@@ -160,6 +163,7 @@ void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord&
       }
       rec.scores = score_frame(frame.label, out.labels);
       rec.errors = error_breakdown(frame.label, out.labels, rec.scores.matches);
+      tracking.add(frame.label, out.labels);
       report.boundary_tolerance_px = boundary_tolerance_px(frame.label.size());  // one camera per set
       for (const auto& [stage, ms] : out.timings_ms) {
         auto it = std::find_if(stage_sums.begin(), stage_sums.end(), [&](const auto& s) { return s.first == stage; });
@@ -188,6 +192,7 @@ void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord&
     run.frames.push_back(std::move(rec));
     progress.step(name);
   }
+  run.tracking += tracking.scores();
   for (const auto& [stage, sum] : stage_sums) run.mean_timings_ms.emplace_back(stage, sum.first / sum.second);
 }
 

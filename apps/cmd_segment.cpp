@@ -26,7 +26,8 @@ void write_frame(const fs::path& out, const Frame& frame, const Result& r, const
   const fs::path debug = out / "debug" / frame.name;
   images.emplace_back(out / "patch" / (frame.name + ".png"), labels_to_u16(r.core_patch_labels));  // 0 = edge
   if (!r.object_labels.empty()) {
-    const cv::Mat labels = params.support.objects_only ? objects_only(r.object_labels, r.objects) : r.object_labels;
+    const cv::Mat labels = params.support.objects_only ? objects_only(r.object_labels, r.objects, params.tracking.enabled)
+                                                       : r.object_labels;
     images.emplace_back(out / "label" / (frame.name + ".png"), labels_to_u16(labels));
     images.emplace_back(debug / "objects.png", render_overlay(labels, frame.color, r.depth));
     images.emplace_back(debug / "graph.png", render_graph(r, frame.camera));

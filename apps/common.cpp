@@ -57,6 +57,7 @@ void ParamOptions::add_to(CLI::App& cmd) {
   cmd.add_option("--threads", threads, "threads (0 = all cores)");
   cmd.add_flag("--no-temporal", no_temporal, "treat frames independently (no temporal smoothing)");
   cmd.add_flag("--objects-only", objects_only, "label 0 for the table and background surfaces");
+  cmd.add_flag("--no-tracking", no_tracking, "number objects 1..M afresh every frame (no stable ids across frames)");
 }
 
 Params ParamOptions::resolve() const {
@@ -67,6 +68,7 @@ Params ParamOptions::resolve() const {
   if (threads) p.threads = *threads;
   if (no_temporal) p.smoothing.temporal = false;
   if (objects_only) p.support.objects_only = true;
+  if (no_tracking) p.tracking.enabled = false;
   return p;
 }
 

@@ -30,7 +30,7 @@ struct ParamOptions {
   std::optional<double> theta_c, theta_h;
   std::optional<std::uint64_t> seed;
   std::optional<int> threads;
-  bool no_temporal = false, objects_only = false;
+  bool no_temporal = false, objects_only = false, no_tracking = false;
   void add_to(CLI::App& cmd);
   Params resolve() const;
 };

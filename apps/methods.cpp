@@ -13,10 +13,10 @@ namespace {
 Method clutterseg_method(Params params) {
   params.support.objects_only = true;
   auto segmenter = std::make_shared<Segmenter>(params);
-  return {"clutterseg", [segmenter](const Frame& frame) {
+  return {"clutterseg", [segmenter, params](const Frame& frame) {
             Result r = segmenter->segment(frame.depth, frame.camera);
             MethodOutput out;
-            out.labels = r.object_labels.empty() ? r.patch_labels : objects_only(r.object_labels, r.objects);
+            out.labels = r.object_labels.empty() ? r.patch_labels : objects_only(r.object_labels, r.objects, params.tracking.enabled);
             out.timings_ms = std::move(r.timings_ms);
             return out;
           }};

@@ -30,6 +30,13 @@ std::string percent(double v) {
   return buf;
 }
 
+std::string fixed2(double v) {
+  if (!std::isfinite(v)) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f", v);
+  return buf;
+}
+
 // Paper scores are given as mean and standard deviation over scenes (the std only when there are two).
 std::string mean_pm_std(const MeanStd& m) {
   if (m.count < 2) return percent(m.mean);
@@ -213,6 +220,16 @@ std::string format_tables(const EvalReport& report) {
       out << "\n";
     }
   }
+  if (report.frames > report.scenes) {  // some scene has several frames: ids across them (docs/EVAL.md)
+    out << "\n### Tracking (ids across the frames of a scene; IoU > 0.5 matches)\n\n"
+        << "| method | object-frames | matched | id kept | id switches per object per 100 frames | ids reused | MOTA |\n"
+        << "|---|---:|---:|---:|---:|---:|---:|\n";
+    for (const auto& run : report.runs) {
+      const TrackingScores& t = run.tracking;
+      out << "| " << run.label << " | " << t.object_frames << " | " << t.matched << " | " << percent(t.id_kept()) << " | "
+          << fixed2(t.switches_per_100()) << " | " << t.reused_ids << " | " << percent(t.mota()) << " |\n";
+    }
+  }
   if (report.sweep_parameter) {
     out << "\n### Sweep of " << *report.sweep_parameter << " (all frames)\n\n| method | " << *report.sweep_parameter
         << " | tp | fp | Overlap F | Boundary F | %>=75 | |\n|---|---:|---:|---:|---:|---:|---:|---|\n";
@@ -252,6 +269,11 @@ nlohmann::json summary_json(const EvalReport& report) {
     r["shown"] = run.shown;
     r["setting"] = nlohmann::json::object();
     for (const auto& [name, value] : run.setting) r["setting"][name] = value;
+    const TrackingScores& t = run.tracking;
+    r["tracking"] = {{"object_frames", t.object_frames}, {"matched", t.matched}, {"steps", t.steps}, {"kept", t.kept},
+                     {"switches", t.switches}, {"false_positives", t.false_positives}, {"objects", t.objects},
+                     {"reused_ids", t.reused_ids}, {"id_kept", number_or_null(t.id_kept())},
+                     {"switches_per_100", number_or_null(t.switches_per_100())}, {"mota", number_or_null(t.mota())}};
     r["groups"] = nlohmann::json::array();
     for (const auto& g : run.groups) {
       nlohmann::json gj = {{"family", g.family}, {"frames", g.frames}, {"scenes", g.scenes},

@@ -12,6 +12,7 @@
 #include "clutterseg/error_breakdown.hpp"
 #include "clutterseg/metrics.hpp"
 #include "clutterseg/params.hpp"
+#include "clutterseg/tracking_metrics.hpp"
 
 namespace clutterseg::app {
 
@@ -54,6 +55,7 @@ struct RunRecord {
   std::vector<std::pair<std::string, std::string>> predictions;  // frame -> JPEG of the prediction
   bool best = false;   // best Overlap F of its sweep
   bool shown = false;  // the run of its method shown in plots and pictures (default or best)
+  TrackingScores tracking;  // ids across the frames of each scene, summed over scenes (docs/EVAL.md)
   const GroupSummary& all() const { return groups.front(); }
 };
 

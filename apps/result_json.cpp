@@ -36,8 +36,15 @@ nlohmann::json result_to_json(const Result& r, const std::string& name) {
     j["objects"].push_back({{"id", o.id}, {"pixels", o.pixel_count}, {"centroid", vec(o.centroid)},
                             {"box", {{"center", vec(o.box.center)}, {"axes", axes}, {"extents", vec(o.box.extents)}}},
                             {"patches", patch_ids}, {"cut_cost", finite_or_null(o.cut_cost)},
-                            {"support", o.support}, {"background", o.background}});
+                            {"support", o.support}, {"background", o.background},
+                            {"age", o.age}, {"frames_missed", o.frames_missed}, {"split_from", o.split_from},
+                            {"merged_with", o.merged_with}});
   }
+  // Tracked objects not seen in this frame (docs/TRACKING.md).
+  j["hidden_objects"] = nlohmann::json::array();
+  for (const auto& h : r.hidden_objects)
+    j["hidden_objects"].push_back({{"id", h.id}, {"age", h.age}, {"frames_since_seen", h.frames_since_seen},
+                                   {"merged_into", h.merged_into}, {"centroid", vec(h.centroid)}});
   if (r.support_plane)
     j["support_plane"] = {{"normal", vec(r.support_plane->normal)}, {"offset", r.support_plane->offset}};
   else

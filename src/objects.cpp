@@ -279,12 +279,15 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
   }
 }
 
-cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects) {
-  // New ids keep the order of the old ones, so the view is as stable as the labels it comes from.
-  std::vector<int> new_id(objects.size() + 1, 0);
+cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects, bool keep_ids) {
+  // New ids keep the order of the old ones, so the view is as stable as the labels it comes from;
+  // tracked ids are kept as they are (object 3 stays object 3).
+  int max_id = 0;
+  for (const auto& o : objects) max_id = std::max(max_id, o.id);
+  std::vector<int> new_id(static_cast<size_t>(max_id) + 1, 0);
   int next = 0;
   for (const auto& o : objects)
-    if (!o.support && !o.background && o.id > 0 && o.id < static_cast<int>(new_id.size())) new_id[static_cast<size_t>(o.id)] = ++next;
+    if (!o.support && !o.background && o.id > 0) new_id[static_cast<size_t>(o.id)] = keep_ids ? o.id : ++next;
   cv::Mat out(object_labels.size(), CV_32S);
   const int last = static_cast<int>(new_id.size()) - 1;
   for (int y = 0; y < object_labels.rows; ++y) {

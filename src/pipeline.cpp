@@ -1,7 +1,8 @@
 // Frames of a stream segmented at once, one per worker (issue 19). The smoothing is the only state
 // carried between frames, so it is the one ordered step: a worker runs it for frame n only after frame
 // n-1's (a ticket), then segments its frame with a Segmenter whose own smoothing is off - the same
-// functions on the same values as Segmenter::segment, so the same labels byte for byte.
+// functions on the same values as Segmenter::segment, so the same labels byte for byte. Object tracking
+// (stable ids) is state too: it runs in pop(), in frame order, as at the end of Segmenter::segment.
 #include "clutterseg/pipeline.hpp"
 
 #include <chrono>
@@ -39,6 +40,7 @@ struct Pipeline::State {
     Camera camera;
     Result result;
     std::exception_ptr error;
+    bool new_scene = false;  // the smoothing saw a scene change at this frame: the tracks restart
     bool done = false;
   };
 
@@ -49,6 +51,9 @@ struct Pipeline::State {
   std::uint64_t next_start = 0;             // the next frame a worker takes
   std::uint64_t front_turn = 0;             // the frame whose smoothing runs next
   TemporalSmoother temporal;
+  cv::Mat last_depth;                       // the previous frame, for scene changes without temporal smoothing
+  Tracker tracker;                          // used by pop() only, in frame order
+  std::mutex tracker_m;
   int active = 0;                           // workers segmenting a frame
   bool adaptive = true;                     // threads = 0: a second frame only on an idle core
   bool stop = false;
@@ -67,6 +72,7 @@ struct Pipeline::State {
     inner.smoothing.median = false;
     inner.smoothing.temporal = false;
     inner.threads = 1;
+    inner.tracking.enabled = false;  // pop() tracks, in frame order
     return inner;
   }
 
@@ -86,7 +92,14 @@ struct Pipeline::State {
       if (sp.median) depth = median_depth(depth);
       median_ms = ms_since(t);
       t = std::chrono::steady_clock::now();
-      smoothed = !sp.temporal ? depth : sp.median ? temporal.push(std::move(depth), sp) : temporal.push(depth, sp);
+      if (sp.temporal) {
+        smoothed = sp.median ? temporal.push(std::move(depth), sp) : temporal.push(depth, sp);
+        slot->new_scene = temporal.restarted();
+      } else {
+        smoothed = depth;
+        slot->new_scene = last_depth.empty() || scene_changed(last_depth, depth, sp);
+        last_depth = depth;
+      }
       temporal_ms = ms_since(t);
     } catch (...) {
       slot->error = std::current_exception();
@@ -146,6 +159,7 @@ Pipeline::Pipeline(Params params) : state_(std::make_unique<State>()) {
   s.adaptive = params.threads <= 0;
   s.capacity = 2 * s.workers;  // every worker busy, and one frame each waiting
   s.params = std::move(params);
+  s.tracker = Tracker(s.params.tracking);
   for (int i = 0; i < s.workers; ++i) s.threads.emplace_back([&s] { s.work(); });
 }
 
@@ -190,7 +204,17 @@ Result Pipeline::pop() {
   s.changed.notify_all();
   lock.unlock();
   if (slot->error) std::rethrow_exception(slot->error);
-  return std::move(slot->result);
+  Result r = std::move(slot->result);
+  if (s.params.tracking.enabled && !r.object_labels.empty()) {
+    const auto t = std::chrono::steady_clock::now();
+    std::lock_guard tracking(s.tracker_m);
+    if (slot->new_scene) s.tracker.forget();
+    r.hidden_objects = s.tracker.update(r.object_labels, r.objects);
+    const double ms = ms_since(t);
+    for (auto& [stage, value] : r.timings_ms)
+      if (stage == "tracking" || stage == "total") value += ms;
+  }
+  return r;
 }
 
 int Pipeline::in_flight() const {
@@ -206,6 +230,9 @@ void Pipeline::reset() {
   std::unique_lock lock(s.m);
   s.changed.wait(lock, [&] { return s.front_turn == s.next_seq; });
   s.temporal.reset();
+  s.last_depth.release();
+  std::lock_guard tracking(s.tracker_m);
+  s.tracker.reset();
 }
 
 }  // namespace clutterseg

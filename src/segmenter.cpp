@@ -73,7 +73,7 @@ void keep_freed_memory() {
 #endif
 }
 
-Segmenter::Segmenter(Params params) : params_(std::move(params)) {
+Segmenter::Segmenter(Params params) : params_(std::move(params)), tracker_(params_.tracking) {
   if (params_.keep_freed_memory) keep_freed_memory();
 }
 
@@ -163,6 +163,13 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
     classify_objects(r.objects, r.patches, r.object_labels, r.points, support_of(*table, r.patches, r.points, p.support),
                      p.support);
   watch.mark("objects");
+  if (p.tracking.enabled && !r.object_labels.empty()) {                          // stable ids (beyond the paper)
+    if (p.smoothing.temporal ? temporal_.restarted() : tracked_depth_.empty() || scene_changed(tracked_depth_, depth, p.smoothing))
+      tracker_.forget();
+    if (!p.smoothing.temporal) tracked_depth_ = depth.clone();
+    r.hidden_objects = tracker_.update(r.object_labels, r.objects);
+  }
+  watch.mark("tracking");
   watch.total();
   return r;
 }

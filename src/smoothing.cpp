@@ -262,7 +262,8 @@ bool scene_changed(const cv::Mat& previous, const cv::Mat& next, const Params::S
 }
 
 cv::Mat TemporalSmoother::make_room(const cv::Mat& next, const Params::Smoothing& params) {
-  if (!window_.empty() && scene_changed(window_.back(), next, params)) window_.clear();
+  restarted_ = window_.empty() || scene_changed(window_.back(), next, params);
+  if (restarted_) window_.clear();
   cv::Mat slot;
   while (static_cast<int>(window_.size()) >= std::max(1, params.temporal_frames)) {
     slot = std::move(window_.front());

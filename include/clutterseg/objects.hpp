@@ -21,7 +21,8 @@ std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat
 void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& patches, const cv::Mat& object_labels,
                       const cv::Mat& points, const Support& support, const Params::Support& params);
 
-// Copy of object_labels with support and background objects set to 0 and the rest renumbered 1..K.
-cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects);
+// Copy of object_labels with support and background objects set to 0 and the rest renumbered 1..K in
+// the order of their ids, or with their ids kept when keep_ids (tracked ids, Params::Tracking).
+cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& objects, bool keep_ids = false);
 
 }  // namespace clutterseg

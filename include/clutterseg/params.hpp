@@ -125,6 +125,20 @@ struct Params {
                                    // largest face is at least this long along the table is a wall [m]
   } support;
 
+  // Beyond the paper: stable object ids across the frames of a stream (tracking.hpp, docs/TRACKING.md).
+  // Segmenter only (stateful); one frame alone gets ids 1..M either way.
+  struct Tracking {
+    bool enabled = true;         // keep ids from frame to frame; false = ids 1..M afresh every frame
+    int max_missed = 30;         // an object unseen (occluded, gone, merged) for more frames than this is
+                                 // forgotten; when it comes back later it gets a new id [frames]
+    double max_step = 0.03;      // largest move of a centroid between two frames beyond what the track's
+                                 // velocity predicts, plus half the object's box diagonal [m]
+    double merge_share = 0.5;    // an object that lost its match merges into (or splits from) the object
+                                 // holding more than this share of its pixels [-]
+    int max_id = 65535;          // ids wrap back to 1 beyond this, skipping ids still in use (fits the
+                                 // uint16 label PNGs and ROS images) [-]
+  } tracking;
+
   std::uint64_t seed = 1;        // every random choice is seeded from this
   int threads = 0;               // 0 = all cores (OpenMP); results do not depend on it
   bool keep_freed_memory = true; // tune glibc malloc to reuse a frame's memory (keep_freed_memory())

@@ -10,7 +10,7 @@ namespace clutterseg {
 
 // A stream of frames in, their Results out in the same order, with the labels Segmenter gives for the
 // same frames (byte for byte). The smoothing (3x3 median, temporal window) is the only state carried from
-// frame to frame: it runs once per frame in frame order; the stages after it (normals to objects) run
+// frame to frame with the object tracks: both run once per frame in frame order (tracking in pop()); the stages after it (normals to objects) run
 // for several frames at once, one frame per worker thread. This raises frames per second, not the
 // latency of a frame (for that, Segmenter's row parallelism). Workers = Params::threads (0 = one per
 // core); each frame's own rows run serially. On a busy machine the workers get what share of the cores

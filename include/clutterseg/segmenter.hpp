@@ -7,6 +7,7 @@
 #include "clutterseg/params.hpp"
 #include "clutterseg/patches.hpp"
 #include "clutterseg/smoothing.hpp"
+#include "clutterseg/tracking.hpp"
 #include "clutterseg/types.hpp"
 
 namespace clutterseg {
@@ -16,7 +17,8 @@ struct Result {
   cv::Mat patch_labels;           // CV_32S, patch id 1..N after edge-pixel assignment, 0 = none
   std::vector<Patch> patches;     // statistics per patch (core pixels)
   std::vector<GraphEdge> graph;   // weighted patch graph with the cue of each link
-  std::vector<Object> objects;    // objects[i].id == i + 1
+  std::vector<Object> objects;    // sorted by id; ids 1..M, or track ids (Params::Tracking, docs/TRACKING.md)
+  std::vector<HiddenObject> hidden_objects;  // tracked objects not seen in this frame (occluded, merged)
   std::optional<Plane> support_plane;  // the table, camera frame
   Timings timings_ms;             // per stage, last entry "total"
 
@@ -29,7 +31,8 @@ struct Result {
   cv::Mat core_patch_labels;  // CV_32S patches before edge pixels were assigned
 };
 
-// Stateful segmenter: keeps the temporal-smoothing window between frames of a stream.
+// Stateful segmenter: keeps the temporal-smoothing window and the object tracks between frames of a
+// stream; both restart on a new scene (scene_changed).
 class Segmenter {
  public:
   explicit Segmenter(Params params = {});
@@ -38,12 +41,17 @@ class Segmenter {
   // Throws Error when the depth type or intrinsics do not fit.
   Result segment(const cv::Mat& depth, const Camera& camera);
 
-  void reset() { temporal_.reset(); }
+  void reset() {  // a new stream: no smoothing window, no tracks, ids from 1
+    temporal_.reset();
+    tracker_.reset();
+  }
   const Params& params() const { return params_; }
 
  private:
   Params params_;
   TemporalSmoother temporal_;
+  Tracker tracker_;
+  cv::Mat tracked_depth_;  // the last frame's depth, for scene changes when temporal smoothing is off
 };
 
 // A frame allocates some 40 MB of images and scratch at 640x480. By default glibc hands blocks that

@@ -32,12 +32,15 @@ class TemporalSmoother {
   // write to (the median's output, say), one copy less.
   cv::Mat push(cv::Mat&& depth, const Params::Smoothing& params);
   void reset() { window_.clear(); }
+  // The last push emptied the window first: a new scene (or the first frame).
+  bool restarted() const { return restarted_; }
   int size() const { return static_cast<int>(window_.size()); }
 
  private:
   cv::Mat make_room(const cv::Mat& next, const Params::Smoothing& params);  // the buffer of the frame that leaves
   cv::Mat smooth_newest(const Params::Smoothing& params) const;
   std::deque<cv::Mat> window_;  // newest last
+  bool restarted_ = false;
 };
 
 }  // namespace clutterseg

@@ -115,7 +115,7 @@ struct Plane {
 };
 
 struct Object {
-  int id = 0;                     // label in the object image (1..M)
+  int id = 0;                     // label in the object image: 1..M, or its track id (Params::Tracking)
   int pixel_count = 0;
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();  // robot frame if a pose is given [m]
   OrientedBox box;                // robot frame if a pose is given
@@ -123,6 +123,11 @@ struct Object {
   float cut_cost = 0;             // cost of the cheapest cut that would split it; +inf for one patch
   bool support = false;           // the table the objects stand on
   bool background = false;        // walls and far surfaces
+  // Tracking (tracking.hpp); without it every object is new: age 1, the rest 0 or empty.
+  int age = 1;                    // frames since it was first seen, this one included [frames]
+  int frames_missed = 0;          // frames it was unseen just before this one (0 = seen in the previous)
+  int split_from = 0;             // id of the object it split off from (0 = none)
+  std::vector<int> merged_with;   // ids of remembered objects merged into it (Tracker: merge)
 };
 
 // Per-stage wall-clock times in milliseconds, in pipeline order; the last entry is "total".

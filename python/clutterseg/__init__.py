@@ -33,6 +33,7 @@ from ._clutterseg import (  # noqa: F401  (re-exported)
     Error,
     FrameScores,
     GraphEdge,
+    HiddenObject,
     Object,
     OrientedBox,
     Patch,
@@ -52,7 +53,7 @@ from ._clutterseg import (  # noqa: F401  (re-exported)
 sys.modules[__name__ + ".synth"] = synth  # so that `import clutterseg.synth` works too
 
 __all__ = [
-    "Camera", "Segmenter", "Result", "Object", "OrientedBox", "Patch", "GraphEdge", "Plane", "Error",
+    "Camera", "Segmenter", "Result", "Object", "HiddenObject", "OrientedBox", "Patch", "GraphEdge", "Plane", "Error",
     "segment", "default_params", "Frame", "Dataset", "read_depth", "read_labels", "read_color", "write_labels",
     "FrameScores", "SCORE_NAMES", "score_frame", "boundary_tolerance_px", "object_boundaries", "mean_std",
     "FrameRecord", "Evaluation", "evaluate", "summarize", "synth",

@@ -31,7 +31,8 @@ struct PyResult {
   // time.perf_counter(): tests see what ran meanwhile, the overhead measurement what was outside it.
   double core_start_s = 0, core_end_s = 0;
   double core_cpu_start_s = 0, core_cpu_end_s = 0;  // CPU time of the calling thread, time.thread_time()'s clock
-  py::object objects, patches, graph, normals, objects_only;
+  py::object objects, patches, graph, normals, objects_only, hidden_objects;
+  bool tracked = false;  // ids are track ids (Params::Tracking): the objects-only view keeps them
 };
 
 double clock_seconds(clockid_t clock) {
@@ -72,6 +73,7 @@ class PySegmenter {
       out->core_cpu_start_s = clock_seconds(CLOCK_THREAD_CPUTIME_ID);
       out->core_start_s = clock_seconds(CLOCK_MONOTONIC);
       out->r = segmenter_->segment(depth, camera);
+      out->tracked = segmenter_->params().tracking.enabled;
       out->core_end_s = clock_seconds(CLOCK_MONOTONIC);
       out->core_cpu_end_s = clock_seconds(CLOCK_THREAD_CPUTIME_ID);
     }
@@ -171,7 +173,8 @@ void bind_parts(py::module_& m) {
   // Every field of clutterseg::Object, one line each (tracking fields are added here the same way).
   py::class_<Object> object(m, "Object", "One object hypothesis of a frame.");
   Fields<Object>(object)
-      .add("id", [](const Object& o) { return o.id; }, "label in Result.object_labels (1..M)")
+      .add("id", [](const Object& o) { return o.id; },
+           "label in Result.object_labels: kept from frame to frame of a stream (tracking), 1..M without tracking")
       .add("pixel_count", [](const Object& o) { return o.pixel_count; }, "pixels carrying this id")
       .add("centroid", [](const Object& o) { return o.centroid; },
            "mean of its 3D points [m], float32 (3,); robot frame if Camera.camera_to_robot is set, else camera frame")
@@ -187,9 +190,26 @@ void bind_parts(py::module_& m) {
            "confidence: cost of the cheapest graph cut that would split it (higher = more firmly one object); inf for one patch")
       .add("support", [](const Object& o) { return o.support; }, "True for the table the objects stand on")
       .add("background", [](const Object& o) { return o.background; }, "True for walls and far surfaces")
+      .add("age", [](const Object& o) { return o.age; }, "frames since it was first seen, this one included (1 = new)")
+      .add("frames_missed", [](const Object& o) { return o.frames_missed; },
+           "frames it was unseen just before this one (0 = seen in the previous frame)")
+      .add("split_from", [](const Object& o) { return o.split_from; }, "id of the object it split off from, 0 = none")
+      .add("merged_with", [](const Object& o) { return o.merged_with; },
+           "ids of remembered objects merged into it (see Result.hidden_objects)")
       .finish();
   object.def_property_readonly(
       "confidence", [](const Object& o) { return o.cut_cost; }, "the same as cut_cost");
+
+  py::class_<HiddenObject> hidden(m, "HiddenObject",
+                                  "A tracked object not seen in this frame: occluded, gone for a while, or merged into another.");
+  Fields<HiddenObject>(hidden)
+      .add("id", [](const HiddenObject& h) { return h.id; }, "its id (it gets it back when it is seen again)")
+      .add("age", [](const HiddenObject& h) { return h.age; }, "frames since it was first seen")
+      .add("frames_since_seen", [](const HiddenObject& h) { return h.frames_since_seen; }, "frames since it was last seen (>= 1)")
+      .add("merged_into", [](const HiddenObject& h) { return h.merged_into; }, "id of the object it merged with, 0 = none")
+      .add("centroid", [](const HiddenObject& h) { return h.centroid; }, "where it was last seen [m], float32 (3,)")
+      .add("box", [](const HiddenObject& h) { return h.box; }, "its OrientedBox when last seen")
+      .finish();
 
   py::class_<Patch> patch(m, "Patch", "A surface patch (paper stage c): statistics over its core pixels.");
   Fields<Patch>(patch)
@@ -241,10 +261,11 @@ void bind_result(py::module_& m) {
       .def_property_readonly(
           "objects_only_labels",
           [](PyResult& p) {
-            return cached(p.objects_only, [&] { return to_numpy(objects_only(p.r.object_labels, p.r.objects)); });
+            return cached(p.objects_only, [&] { return to_numpy(objects_only(p.r.object_labels, p.r.objects, p.tracked)); });
           },
-          "int32 (H, W): object_labels with the support plane and background set to 0 and the rest renumbered\n"
-          "1..K (what `clutterseg segment --objects-only` writes and `clutterseg eval` scores)")
+          "int32 (H, W): object_labels with the support plane and background set to 0; the rest keep their ids\n"
+          "when tracking (tracking.enabled), else are renumbered 1..K (what `clutterseg segment --objects-only`\n"
+          "writes and `clutterseg eval` scores)")
       .def_property_readonly(
           "patch_labels", [](const PyResult& p) { return to_numpy(p.r.patch_labels); },
           "int32 (H, W): surface patch id 1..N per pixel after edge pixels were assigned, 0 = none")
@@ -283,7 +304,11 @@ void bind_result(py::module_& m) {
           "edges", [](const PyResult& p) { return to_numpy(p.r.edges); }, "uint8 (H, W): 255 = edge pixel")
       .def_property_readonly(
           "objects", [](PyResult& p) { return cached(p.objects, [&] { return to_list(p.r.objects); }); },
-          "list of Object, objects[i].id == i + 1")
+          "list of Object, sorted by id (objects[i].id == i + 1 without tracking)")
+      .def_property_readonly(
+          "hidden_objects",
+          [](PyResult& p) { return cached(p.hidden_objects, [&] { return to_list(p.r.hidden_objects); }); },
+          "list of HiddenObject: tracked objects not seen in this frame, sorted by id")
       .def_property_readonly(
           "patches", [](PyResult& p) { return cached(p.patches, [&] { return to_list(p.r.patches); }); },
           "list of Patch, patches[i].id == i + 1")

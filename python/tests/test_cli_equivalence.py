@@ -63,5 +63,6 @@ def test_objects_only_labels_equal_the_cli_with_objects_only(tmp_path):
         cli_labels = clutterseg.read_labels(tmp_path / "label" / f"{frame.name}.png")
         assert np.array_equal(result.objects_only_labels, cli_labels)
         kept = [o for o in result.objects if not (o.support or o.background)]
-        assert result.objects_only_labels.max() == len(kept)
+        # Tracked ids (on by default) are kept in the objects-only view: the ids of the kept objects.
+        assert set(np.unique(result.objects_only_labels)) - {0} == {o.id for o in kept}
         assert not np.array_equal(result.objects_only_labels, result.object_labels)

@@ -176,6 +176,10 @@ ObjectArray objects_message(const clutterseg::Result& r, const std::vector<int>&
     m.confidence = o.cut_cost;
     m.support = o.support;
     m.background = o.background;
+    m.age = static_cast<uint32_t>(o.age);
+    m.frames_missed = static_cast<uint32_t>(o.frames_missed);
+    m.split_from = static_cast<uint32_t>(o.split_from);
+    m.merged_with.assign(o.merged_with.begin(), o.merged_with.end());
     msg.objects.push_back(m);
   }
   std::sort(msg.objects.begin(), msg.objects.end(), [](const Object& a, const Object& b) { return a.id < b.id; });

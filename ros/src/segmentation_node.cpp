@@ -139,7 +139,7 @@ void SegmentationNode::process(const Frame& frame) {
   const ros::WallTime start = ros::WallTime::now();
   const std_msgs::Header& header = frame.image->header;
   if (last_stamp_ && header.stamp < *last_stamp_) {  // a bag started again, or the driver restarted
-    ROS_WARN("%s: time went backwards on %s; temporal smoothing starts again", pnh_.getNamespace().c_str(),
+    ROS_WARN("%s: time went backwards on %s; temporal smoothing and object ids start again", pnh_.getNamespace().c_str(),
              input_topic_.c_str());
     segmenter_.reset();
   }
@@ -151,7 +151,8 @@ void SegmentationNode::process(const Frame& frame) {
   const ros::WallTime segmented = ros::WallTime::now();
 
   // The label image `clutterseg segment` writes: the objects-only view when support.objects_only is set.
-  const cv::Mat view = params_.support.objects_only ? clutterseg::objects_only(r.object_labels, r.objects) : r.object_labels;
+  const cv::Mat view = params_.support.objects_only ? clutterseg::objects_only(r.object_labels, r.objects, params_.tracking.enabled)
+                                                        : r.object_labels;
   if (labels_pub_.getNumSubscribers() > 0) {
     const cv_bridge::CvImage labels(header, "16UC1", clutterseg::labels_to_u16(view));
     labels_pub_.publish(labels.toImageMsg(), frame.info);

@@ -42,7 +42,9 @@ Eigen::Vector3d rotation_xyz_deg(const Eigen::Matrix3d& R) {
 
 json frame_json(const std::string& name, const SynthFrame& f) {
   json objects = json::array();
-  std::vector<int> pixels(f.scene.objects.size() + 1, 0);
+  int max_id = 0;  // ids may skip removed objects (pick-and-place)
+  for (const auto& o : f.scene.objects) max_id = std::max(max_id, o.id);
+  std::vector<int> pixels(static_cast<size_t>(max_id) + 1, 0);
   for (int i = 0; i < f.sensor.labels.rows * f.sensor.labels.cols; ++i) {
     const int id = f.sensor.labels.at<int>(i);
     if (id > 0 && id < static_cast<int>(pixels.size())) ++pixels[static_cast<size_t>(id)];
@@ -53,6 +55,7 @@ json frame_json(const std::string& name, const SynthFrame& f) {
               {"pose", {{"position", vec(o.pose.translation())}, {"rotation_xyz_deg", vec(rotation_xyz_deg(o.pose.linear()))}}},
               {"visible_pixels", pixels[static_cast<size_t>(o.id)]}};
     if (s.type == ShapeType::Cup || s.type == ShapeType::Bowl) j["wall"] = vec(Eigen::Vector3d::Constant(s.wall))[0];
+    if (o.held) j["held"] = true;
     objects.push_back(j);
   }
   return {{"name", name}, {"family", f.scene.family},

@@ -32,6 +32,8 @@ const std::vector<PresetInfo> kPresets = {
     {"mixed", "Table II family: 3-7 boxes, cylinders, spheres, bowls and cups", 3, 7},
     {"complex", "Table II family: 8-14 objects of every kind, stacked and occluding", 8, 14},
     {"sequence", "one box sliding across a static scene of 3 objects (for temporal smoothing)", 4, 4},
+    {"pick-and-place", "60 frames: two objects lifted away one at a time, one carried and put down elsewhere, one "
+                       "sliding behind a tall box, the camera swaying slightly (for tracking)", 3, 5},
 };
 
 // Uniform numbers from a 64-bit generator, identical on every standard library.
@@ -116,6 +118,7 @@ struct Item {
   double base = 0, top = 0;  // z of the bottom and top [m]
   bool flat_top = false;     // a box: others may rest on it
   int support = -1;          // index of the item it rests on, -1 = table
+  bool gone = false;         // taken out of the scene (pick-and-place); keeps its id slot
 };
 
 cv::Vec3b random_colour(Rng& rng) {
@@ -309,6 +312,92 @@ Kind random_kind(Rng& rng, bool with_open) {
   return all[rng.integer(0, n - 1)];
 }
 
+// A small object for pick-and-place: any kind but lying cylinders and bowls, no wider than 9 cm.
+Item small_item(Kind kind, Rng& rng) {
+  Item it = make_item(kind, rng);
+  const double reach = it.footprint.round() ? it.footprint.radius : it.footprint.half.norm();
+  if (reach > 0.045) {  // scale the footprint down, keep the height
+    const double f = 0.045 / reach;
+    it.shape.size.x() *= f;
+    it.shape.size.y() *= f;
+    it.info.size.x() *= f;
+    it.info.size.y() *= f;
+    it.footprint.half *= f;
+    it.footprint.radius *= f;
+    if (it.info.type == "sphere") {  // a sphere stays round
+      it.shape.size = Vector3d::Constant(it.shape.size.x());
+      it.info.size = Vector3d::Constant(it.info.size.x());
+      it.top = it.info.size.z();
+    }
+  }
+  return it;
+}
+
+// Table positions of pick-and-place, in the layout's frame: along `across` and `toward_camera` [m].
+Vector2d pick_spot(const Layout& lay, double across, double toward) {
+  return lay.centre + across * lay.across + toward * lay.toward_camera;
+}
+
+// Items of pick-and-place (ids by index + 1): 1 a tall narrow box, 2 a box that later slides behind it,
+// 3 and 5 objects lifted away, 4 an object carried to where 3 stood. Placed at frame 0 with every check;
+// the places they move to are checked here too, so that every frame of a seed keeps one layout.
+bool build_pick_and_place(std::vector<Item>& items, const Layout& lay, Rng& rng) {
+  const double yaw_across = std::atan2(lay.across.y(), lay.across.x());
+  Item tall = make_item(Kind::Box, rng);
+  const double w = rng.uniform(0.045, 0.06), h = rng.uniform(0.16, 0.2);
+  tall.shape.size = {w / 2, w / 2, h / 2};
+  tall.info.size = {w, w, h};
+  tall.footprint.half = {w / 2, w / 2};
+  tall.top = h;
+  Item mover = make_item(Kind::Box, rng);
+  const Vector3d full(rng.uniform(0.05, 0.07), rng.uniform(0.04, 0.06), rng.uniform(0.05, 0.08));
+  mover.shape.size = full / 2;
+  mover.info.size = full;
+  mover.footprint.half = full.head<2>() / 2;
+  mover.top = full.z();
+  const Kind kinds[] = {Kind::Box, Kind::Standing, Kind::Sphere, Kind::Cup};
+  Item first = small_item(kinds[rng.integer(0, 3)], rng), carried = small_item(rng.chance(0.5) ? Kind::Box : Kind::Standing, rng);
+  Item last = small_item(kinds[rng.integer(0, 3)], rng);
+  if (!place_on_table(tall, items, lay, rng, 0.01, pick_spot(lay, 0, 0.03), yaw_across) ||
+      !place_on_table(mover, items, lay, rng, 0.01, pick_spot(lay, -0.2, -0.1), yaw_across) ||
+      !place_on_table(first, items, lay, rng, 0.01, pick_spot(lay, -0.16, 0.15), rng.uniform(-M_PI, M_PI)) ||
+      !place_on_table(carried, items, lay, rng, 0.01, pick_spot(lay, 0.16, 0.15), rng.uniform(-M_PI, M_PI)) ||
+      !place_on_table(last, items, lay, rng, 0.01, pick_spot(lay, 0.12, -0.24), rng.uniform(-M_PI, M_PI)))
+    return false;
+  // Where the mover ends and where the carried object is put down must be free and on the table too.
+  std::vector<Item> others = {items[0], items[4]};
+  if (!place_on_table(items[1], others, lay, rng, 0.01, pick_spot(lay, 0.2, -0.1), yaw_across)) return false;
+  others = {items[0], items[1], items[4]};
+  return place_on_table(items[3], others, lay, rng, 0.01, pick_spot(lay, -0.16, 0.15), items[3].footprint.yaw);
+}
+
+// Frame `frame` of pick-and-place: moves, lifts and removes items (no random numbers: every frame of a
+// seed draws the same layout). Frames past 59 keep the last state.
+void animate_pick_and_place(std::vector<Item>& items, const Layout& lay, int frame) {
+  const double f = std::clamp(frame, 0, 59);
+  const auto ramp = [&](double from, double to) { return std::clamp((f - from) / (to - from), 0.0, 1.0); };
+  const auto lift = [](Item& it, const Vector2d& xy, double height) {
+    put(it, xy, it.footprint.yaw, height);
+    it.info.held = height > 0;
+  };
+  // 3 (index 2): lifted 3 cm per frame over frames 8-10, gone from 11.
+  Item& first = items[2];
+  if (f >= 11) first.gone = true;
+  else lift(first, first.footprint.centre, 0.03 * std::max(0.0, f - 7));
+  // 4 (index 3): lifted over 14-16, carried across over 17-26 at 9 cm, lowered over 27-29 onto 3's place.
+  Item& carried = items[3];
+  const Vector2d from = pick_spot(lay, 0.16, 0.15), to = pick_spot(lay, -0.16, 0.15);
+  const double height = 0.09 * (ramp(13, 16) - ramp(26, 29));
+  lift(carried, from + ramp(16, 26) * (to - from), height);
+  // 2 (index 1): slides behind the tall box over frames 34-57, 1.7 cm per frame.
+  Item& mover = items[1];
+  put(mover, pick_spot(lay, -0.2 + 0.4 * ramp(33, 57), -0.1), mover.footprint.yaw, 0);
+  // 5 (index 4): lifted over 44-46, gone from 47.
+  Item& last = items[4];
+  if (f >= 47) last.gone = true;
+  else lift(last, last.footprint.centre, 0.03 * std::max(0.0, f - 43));
+}
+
 // Fills `items` for the preset; returns false when the layout did not fit (the caller retries).
 bool build(const std::string& preset, std::vector<Item>& items, const Layout& lay, Rng& rng, int frame) {
   const PresetInfo& info = preset_info(preset);
@@ -384,6 +473,7 @@ bool build(const std::string& preset, std::vector<Item>& items, const Layout& la
     items.push_back(mover);
     return true;
   }
+  if (preset == "pick-and-place") return build_pick_and_place(items, lay, rng);
   // The Table II families.
   const int n = count();
   const bool stacked = preset == "stacked-boxes", complex = preset == "complex";
@@ -451,7 +541,8 @@ const PresetInfo& preset_info(const std::string& name) {
 
 GeneratedScene generate_scene(const std::string& preset, std::uint64_t seed, int frame, const Camera& camera) {
   const PresetInfo& info = preset_info(preset);
-  const bool sequence = preset == "sequence";
+  const bool pick = preset == "pick-and-place";
+  const bool sequence = preset == "sequence" || pick;
   Rng rng(mix_seed(seed, sequence ? 0x5e9 : static_cast<std::uint64_t>(frame)));
   GeneratedScene out;
   out.family = info.name;
@@ -462,7 +553,7 @@ GeneratedScene generate_scene(const std::string& preset, std::uint64_t seed, int
     items.clear();
     // Occlusion presets need room between camera and scene for the occluder (Kinect sees nothing below 0.5 m).
     const bool occlusion = preset == "occluded-box" || preset == "lying-cylinder-occluded";
-    const double distance = rng.uniform(occlusion ? 0.8 : 0.5, 1.5), elevation = rng.uniform(30, 70) * kDeg, azimuth = rng.uniform(-35, 35) * kDeg;
+    const double distance = rng.uniform(occlusion || pick ? 0.8 : 0.5, pick ? 1.2 : 1.5), elevation = rng.uniform(30, 70) * kDeg, azimuth = rng.uniform(-35, 35) * kDeg;
     lay.toward_camera = Vector2d(std::sin(azimuth), -std::cos(azimuth));
     lay.across = Vector2d(std::cos(azimuth), std::sin(azimuth));
     lay.table_half = Vector2d(rng.uniform(0.45, 0.8), rng.uniform(0.35, 0.6));
@@ -474,11 +565,11 @@ GeneratedScene generate_scene(const std::string& preset, std::uint64_t seed, int
     out.target = target;
     lay.eye = out.eye;
     out.world_to_camera = look_at(out.eye, out.target);
-    if (!build(preset, items, lay, rng, frame)) continue;
+    if (!build(preset, items, lay, rng, pick ? 0 : frame)) continue;
     // Every object's centre in the image.
     bool ok = true;
     for (const Item& it : items) {
-      if (sequence && &it == &items.back()) continue;  // the sliding box stays within the region
+      if (preset == "sequence" && &it == &items.back()) continue;  // the sliding box stays within the region
       const Vector3d c = out.world_to_camera * it.info.pose.translation();
       const double u = camera.cx + camera.fx * c.x() / c.z(), v = camera.cy + camera.fy * c.y() / c.z();
       if (c.z() <= 0.2 || u < 0.05 * camera.width || u > 0.95 * camera.width || v < 0.05 * camera.height || v > 0.95 * camera.height) ok = false;
@@ -489,8 +580,17 @@ GeneratedScene generate_scene(const std::string& preset, std::uint64_t seed, int
   }
   Rng background_rng(mix_seed(seed, sequence ? 0xb9 : 0xb9 + 0x100000000ULL * static_cast<std::uint64_t>(frame)));
   add_background(out.scene, lay, background_rng);
+  if (pick) {
+    animate_pick_and_place(items, lay, frame);
+    // The camera sways by up to 1.5 cm sideways and 1 cm up and down (at most 2.2 mm per frame).
+    const double f = std::clamp(frame, 0, 59);
+    const Vector3d across(lay.across.x(), lay.across.y(), 0);
+    out.eye += 0.015 * std::sin(2 * M_PI * f / 60) * across + 0.01 * std::sin(2 * M_PI * f / 40) * Vector3d::UnitZ();
+    out.world_to_camera = look_at(out.eye, out.target);
+  }
   for (size_t i = 0; i < items.size(); ++i) {
     Item& it = items[i];
+    if (it.gone) continue;  // its id is not given to another object
     it.shape.label = static_cast<int>(i) + 1;
     it.info.id = static_cast<int>(i) + 1;
     it.info.shape = static_cast<int>(out.scene.shapes.size());

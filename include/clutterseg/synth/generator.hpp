@@ -22,11 +22,12 @@ const std::vector<PresetInfo>& presets();
 const PresetInfo& preset_info(const std::string& name);
 
 struct ObjectInfo {
-  int id = 0;                 // label in the label image (1..n)
+  int id = 0;                 // label in the label image (1..n; pick-and-place: ids of removed objects are skipped)
   std::string type;           // box, book, cylinder, sphere, bowl, cup
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  // full extents along the object's own x, y, z [m]
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // object frame (its bounding-box centre) -> world
   int shape = 0;              // index into GeneratedScene::scene.shapes
+  bool held = false;          // lifted or carried (pick-and-place): in the air, not resting
 };
 
 struct GeneratedScene {
@@ -38,7 +39,9 @@ struct GeneratedScene {
 };
 
 // Frame `frame` of a preset: a function of (preset, seed, frame) only. `sequence` keeps the scene and
-// camera of frame 0 and moves one object a little every frame.
+// camera of frame 0 and moves one object a little every frame; `pick-and-place` keeps the scene of frame 0
+// and lifts, carries and slides objects (an object keeps its id in every frame; a removed one's id is
+// never given to another).
 GeneratedScene generate_scene(const std::string& preset, std::uint64_t seed, int frame, const Camera& camera);
 
 }  // namespace clutterseg::synth
