@@ -60,8 +60,9 @@ def test_python_runs_while_a_frame_is_segmented(example_frame):
 
 def test_one_segmenter_shared_by_threads_takes_turns():
     frames = list(clutterseg.Dataset(DATA_DIR / "ycbv-0000"))[:4]
-    segmenter = clutterseg.Segmenter(smoothing__temporal=False)  # every call independent of the order
-    expected = stream(frames, clutterseg.Segmenter(smoothing__temporal=False))
+    # Every call independent of the order: no temporal window, no tracked ids.
+    segmenter = clutterseg.Segmenter(smoothing__temporal=False, tracking__enabled=False)
+    expected = stream(frames, clutterseg.Segmenter(smoothing__temporal=False, tracking__enabled=False))
     got = [[None] * len(frames) for _ in range(2)]
 
     def run(k):
