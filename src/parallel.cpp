@@ -1,5 +1,7 @@
 #include "clutterseg/parallel.hpp"
 
+#include <atomic>
+#include <exception>
 #include <opencv2/core/utility.hpp>
 
 #ifdef _OPENMP
@@ -23,12 +25,24 @@ void parallel_for_rows(int rows, const std::function<void(int, int)>& body) {
   // Blocks of rows amortise the call; the split never changes what each row computes.
   constexpr int kBlock = 16;
   const int blocks = (rows + kBlock - 1) / kBlock;
+  // An exception may not leave an OpenMP region (the process would terminate): the first one is kept,
+  // the remaining blocks are skipped, and it is thrown again on the calling thread.
+  std::exception_ptr failure;
+  std::atomic<bool> failed{false};
 #pragma omp parallel for schedule(static)
   for (int b = 0; b < blocks; ++b) {
+    if (failed.load(std::memory_order_relaxed)) continue;
     const int begin = b * kBlock;
     const int end = begin + kBlock < rows ? begin + kBlock : rows;
-    body(begin, end);
+    try {
+      body(begin, end);
+    } catch (...) {
+#pragma omp critical(clutterseg_parallel_failure)
+      if (!failure) failure = std::current_exception();
+      failed.store(true, std::memory_order_relaxed);
+    }
   }
+  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace clutterseg

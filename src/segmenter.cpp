@@ -7,6 +7,7 @@
 #include "clutterseg/cutfree.hpp"
 #include "clutterseg/edges.hpp"
 #include "clutterseg/graph_cut.hpp"
+#include "clutterseg/limits.hpp"
 #include "clutterseg/normals.hpp"
 #include "clutterseg/objects.hpp"
 #include "clutterseg/parallel.hpp"
@@ -74,6 +75,7 @@ void keep_freed_memory() {
 }
 
 Segmenter::Segmenter(Params params) : params_(std::move(params)) {
+  validate(params_);  // every parameter within its documented range (limits.hpp)
   if (params_.keep_freed_memory) keep_freed_memory();
 }
 
