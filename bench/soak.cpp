@@ -1,7 +1,7 @@
 // Soak benchmark: many frames through ONE Segmenter (temporal smoothing on), resident memory sampled.
 // A leak or a buffer that grows with the stream shows as a rising RSS after the warm-up.
-//   soak DATASET[,DATASET...] FRAMES EVERY OUT.csv
-// Frames of the given dataset folders are played in a loop; every EVERY frames one CSV row is written:
+//   soak DATASET[,DATASET...] FRAMES EVERY OUT.csv [SUBSAMPLE]
+// Frames of the given dataset folders (every SUBSAMPLE-th pixel, default 1) are played in a loop; every EVERY frames one CSV row is written:
 // frame, RSS [MB], median and max frame time of the block [ms]. Prints a summary line at the end.
 #include <unistd.h>
 
@@ -35,15 +35,24 @@ struct Frame {
 
 int main(int argc, char** argv) {
   using namespace clutterseg;
-  if (argc != 5) {
-    std::cerr << "usage: soak DATASET[,DATASET...] FRAMES EVERY OUT.csv\n";
+  if (argc != 5 && argc != 6) {
+    std::cerr << "usage: soak DATASET[,DATASET...] FRAMES EVERY OUT.csv [SUBSAMPLE]\n";
     return 2;
   }
   std::vector<Frame> frames;
   std::stringstream sets(argv[1]);
   for (std::string set; std::getline(sets, set, ',');) {
-    const Camera camera = read_camera_json(fs::path(set) / "camera.json");
-    for (const FrameFiles& f : list_dataset(set)) frames.push_back({read_depth_png(f.depth), camera});
+    Camera camera = read_camera_json(fs::path(set) / "camera.json");
+    const int sub = argc == 6 ? std::max(1, std::stoi(argv[5])) : 1;
+    camera.fx /= sub, camera.fy /= sub, camera.cx /= sub, camera.cy /= sub;
+    camera.width = (camera.width + sub - 1) / sub, camera.height = (camera.height + sub - 1) / sub;
+    for (const FrameFiles& f : list_dataset(set)) {
+      const cv::Mat full = read_depth_png(f.depth);
+      cv::Mat small(camera.height, camera.width, CV_16U);
+      for (int y = 0; y < small.rows; ++y)
+        for (int x = 0; x < small.cols; ++x) small.at<std::uint16_t>(y, x) = full.at<std::uint16_t>(y * sub, x * sub);
+      frames.push_back({small, camera});
+    }
   }
   const long total = std::stol(argv[2]), every = std::max(1L, std::stol(argv[3]));
   std::ofstream csv(argv[4]);

@@ -89,7 +89,7 @@ void check_frame_size(std::int64_t width, std::int64_t height, const std::string
   if (width > kMaxFrameSide || height > kMaxFrameSide || width * height > kMaxFramePixels)
     throw Error(what + ": " + std::to_string(width) + "x" + std::to_string(height) +
                 " is beyond the largest frame clutterseg takes (" + std::to_string(kMaxFramePixels) +
-                " pixels, " + std::to_string(kMaxFrameSide) + " a side; about 160 bytes of memory per pixel)");
+                " pixels, " + std::to_string(kMaxFrameSide) + " a side; about 85 bytes of memory per pixel)");
 }
 
 }  // namespace clutterseg

@@ -15,8 +15,8 @@ namespace clutterseg {
 // docs/RELIABILITY.md. Called by the Segmenter's constructor and by params_from_json.
 void validate(const Params& params);
 
-// Largest frame: 2^23 pixels (a 3840x2160 sensor fits) and 16384 pixels a side. The pipeline needs about
-// 160 bytes per pixel (docs/RELIABILITY.md: 50 MB at 640x480), so the largest frame takes about 1.4 GB.
+// Largest frame: 2^23 pixels (a 3840x2160 sensor fits) and 16384 pixels a side. The pipeline needs about 85
+// bytes per pixel besides a fixed ~100 MB (docs/RELIABILITY.md), so the largest frame takes about 0.8 GB.
 inline constexpr int kMaxFrameSide = 16384;
 inline constexpr std::int64_t kMaxFramePixels = std::int64_t{1} << 23;
 
