@@ -35,7 +35,7 @@ void check_type(const nlohmann::json& value, const nlohmann::json& known, const 
   const auto fail = [&](const std::string& problem) {
     std::string shown = value.dump();
     if (shown.size() > 40) shown = shown.substr(0, 37) + "...";
-    throw Error(what + ": parameter " + key + " = " + shown + ": " + problem);
+    throw Error(what + ": parameter '" + key + "' = " + shown + ": " + problem);
   };
   if (known.is_object() && !value.is_object()) fail("must be an object of parameters");
   if (known.is_boolean() && !value.is_boolean()) fail("must be true or false");

@@ -20,17 +20,17 @@ std::string shown(double v) {
 // Each check names the key as --dump-config does. Ranges are closed; NaN fails every one.
 void in_range(const char* key, double value, double lo, double hi) {
   if (!(value >= lo && value <= hi))
-    throw Error(std::string("parameter ") + key + " = " + shown(value) + ": must be a number in [" + shown(lo) +
+    throw Error(std::string("parameter '") + key + "' = " + shown(value) + ": must be a number in [" + shown(lo) +
                 ", " + shown(hi) + "]");
 }
 void above(const char* key, double value, double lo, double hi) {  // (lo, hi]
   if (!(value > lo && value <= hi))
-    throw Error(std::string("parameter ") + key + " = " + shown(value) + ": must be a number in (" + shown(lo) +
+    throw Error(std::string("parameter '") + key + "' = " + shown(value) + ": must be a number in (" + shown(lo) +
                 ", " + shown(hi) + "]");
 }
 void int_range(const char* key, int value, int lo, int hi) {
   if (value < lo || value > hi)
-    throw Error(std::string("parameter ") + key + " = " + std::to_string(value) + ": must be an integer in [" +
+    throw Error(std::string("parameter '") + key + "' = " + std::to_string(value) + ": must be an integer in [" +
                 std::to_string(lo) + ", " + std::to_string(hi) + "]");
 }
 
@@ -43,7 +43,7 @@ void validate(const Params& p) {
   int_range("normals.step_px", p.normals.step_px, 1, 16);
   int_range("normals.smooth_ksize", p.normals.smooth_ksize, 1, 31);
   if (p.normals.smooth_ksize % 2 == 0)
-    throw Error("parameter normals.smooth_ksize = " + std::to_string(p.normals.smooth_ksize) + ": must be odd");
+    throw Error("parameter 'normals.smooth_ksize' = " + std::to_string(p.normals.smooth_ksize) + ": must be odd");
   in_range("edges.theta", p.edges.theta, 0, 1);
   int_range("edges.step_px", p.edges.step_px, 1, 16);
   above("edges.jump_slope", p.edges.jump_slope, 0, 1e6);

@@ -170,11 +170,11 @@ TEST(Reliability, ConfigValuesAreTypeAndRangeCheckedNamingTheKey) {
   };
   for (const auto& [text, key] : inline_cases) {
     const std::string message = error_of([&] { params_from_json(text, "cfg.json"); });
-    EXPECT_EQ(message.rfind("cfg.json: parameter " + key + " = ", 0), 0u) << text << ": " << message;
+    EXPECT_EQ(message.rfind("cfg.json: parameter '" + key + "' = ", 0), 0u) << text << ": " << message;
   }
   const fs::path file = tmp / "config.json";
   { std::ofstream(file) << inline_cases[0].first; }
-  expect_refused(segment(file), file.string() + ": parameter threads = 1.5", "integer", tmp / "out", "threads 1.5");
+  expect_refused(segment(file), file.string() + ": parameter 'threads' = 1.5", "integer", tmp / "out", "threads 1.5");
 }
 
 TEST(Reliability, CommandLineParametersAreRangeChecked) {
@@ -187,7 +187,7 @@ TEST(Reliability, CommandLineParametersAreRangeChecked) {
     EXPECT_FALSE(fs::exists(tmp / "out")) << flag;
   }
   const auto r = run_bounded("segment " + depth.string() + " --fx 60 --theta-c -1 --out " + (tmp / "out").string(), tmp);
-  EXPECT_NE(r.err.find("parameter graph.theta_c = -1"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("parameter 'graph.theta_c' = -1"), std::string::npos) << r.err;
 }
 
 TEST(Reliability, EveryParameterHasARangeTheDefaultsMeet) {
@@ -195,7 +195,7 @@ TEST(Reliability, EveryParameterHasARangeTheDefaultsMeet) {
   EXPECT_NO_THROW(params_from_json(params_to_json(Params{}), "defaults"));
   Params p;
   p.patches.histogram_bins = 0;
-  EXPECT_NE(error_of([&] { Segmenter s(p); }).find("parameter patches.histogram_bins = 0"), std::string::npos);
+  EXPECT_NE(error_of([&] { Segmenter s(p); }).find("parameter 'patches.histogram_bins' = 0"), std::string::npos);
   p = Params{};
   p.graph.theta_c = std::nan("");
   EXPECT_NE(error_of([&] { Segmenter s(p); }).find("graph.theta_c"), std::string::npos);

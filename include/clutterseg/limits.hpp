@@ -10,7 +10,7 @@
 
 namespace clutterseg {
 
-// Throws Error("parameter KEY = VALUE: must be ...") for the first parameter outside its range; KEY is
+// Throws Error("parameter 'KEY' = VALUE: must be ...") for the first parameter outside its range; KEY is
 // the name of --dump-config (e.g. graph.theta_c). The ranges are in src/limits.cpp, one line per key, and
 // docs/RELIABILITY.md. Called by the Segmenter's constructor and by params_from_json.
 void validate(const Params& params);
