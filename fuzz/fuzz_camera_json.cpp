@@ -1,5 +1,6 @@
 // camera.json reader: any bytes give intrinsics that pass check_camera for their own size, or Error.
 #include "clutterseg/io.hpp"
+#include "clutterseg/params.hpp"
 #include "fuzz_common.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -55,7 +55,7 @@ std::string error_of(const std::function<void()>& f) {
 TEST(Reliability, FuzzedPcdFilesAreRefusedBeforePclReadsThem) {
   const fs::path tmp = fresh_dir("rel-pcd");
   const std::vector<fs::path> named = {kBad / "pcd-fuzzed.pcd", kBad / "pcd-compressed-zero-size.pcd", kBad / "pcd-min.pcd",
-                                       kBad / "pcd-lzf-damaged.pcd"};
+                                       kBad / "pcd-lzf-damaged.pcd", kBad / "pcd-viewpoint-not-a-number.pcd"};
   for (const fs::path& f : named) {
     const fs::path out = tmp / "out";
     const auto r = run_bounded("segment " + f.string() + " --fx 525 --out " + out.string(), tmp);
@@ -169,7 +169,7 @@ TEST(Reliability, ConfigValuesAreTypeAndRangeCheckedNamingTheKey) {
       {R"({"patches": {"min_size_px": 99999999999}})", "patches.min_size_px"},
   };
   for (const auto& [text, key] : inline_cases) {
-    const std::string message = error_of([&] { params_from_json(text, "cfg.json"); });
+    const std::string message = error_of([&text = text] { params_from_json(text, "cfg.json"); });
     EXPECT_EQ(message.rfind("cfg.json: parameter '" + key + "' = ", 0), 0u) << text << ": " << message;
   }
   const fs::path file = tmp / "config.json";

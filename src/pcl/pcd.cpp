@@ -187,7 +187,19 @@ void check_header(const std::filesystem::path& path, const std::string& what) {
   const std::int64_t points = width * height;
   if (header.count("POINTS") && (header["POINTS"].size() != 1 || whole_number(header["POINTS"][0], kMaxFramePixels) != points))
     bad("POINTS differs from WIDTH x HEIGHT");
-  if (header.count("VIEWPOINT") && header["VIEWPOINT"].size() != 7) bad("VIEWPOINT needs 7 numbers");
+  // PCL converts these words with std::stof and friends, which throw on anything but a number.
+  const auto numbers = [&](const char* key, size_t count) {
+    if (!header.count(key)) return;
+    if (header[key].size() != count) bad(std::string(key) + " needs " + std::to_string(count) + " numbers");
+    for (const std::string& word : header[key]) {
+      double v = 0;
+      const auto [end, err] = std::from_chars(word.data(), word.data() + word.size(), v);
+      if (err != std::errc() || end != word.data() + word.size() || !std::isfinite(v))
+        bad(std::string(key) + " holds '" + printable(word) + "', not a number");
+    }
+  };
+  numbers("VERSION", 1);
+  numbers("VIEWPOINT", 7);
   const auto& kind = header["DATA"];
   if (kind.size() != 1) bad("DATA needs one word");
   const std::uintmax_t payload = static_cast<std::uintmax_t>(points) * static_cast<std::uintmax_t>(point_size);
@@ -229,7 +241,13 @@ PcdFrame read_organized_pcd(const std::filesystem::path& path, const std::option
   {
     baselines::QuietPcl quiet;
     pcl::PCDReader reader;
-    if (reader.read(what, blob) < 0) throw Error(what + ": not a readable PCD file");
+    try {
+      if (reader.read(what, blob) < 0) throw Error(what + ": not a readable PCD file");
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {  // PCL's reader throws what its conversions throw
+      throw Error(what + ": not a readable PCD file (" + printable(e.what()) + ")");
+    }
   }
   if (!has_field(blob, "x") || !has_field(blob, "y") || !has_field(blob, "z"))
     throw Error(what + ": PCD has no x/y/z fields");
