@@ -71,6 +71,9 @@ TEST(Reliability, FuzzedPcdFilesAreRefusedBeforePclReadsThem) {
     ++refused;
   }
   EXPECT_GE(refused, 17);
+  // Found by fuzz_pcd: points 4e16 px off their pixels (the message's int conversion overflowed).
+  const fs::path far = kBad / "pcd-not-a-projection-huge.pcd";
+  EXPECT_NE(error_of([&] { read_organized_pcd(far); }).find("1000000 or more px"), std::string::npos);
 #endif
 }
 

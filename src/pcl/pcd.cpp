@@ -69,7 +69,8 @@ Camera fit_intrinsics(const pcl::PointCloud<pcl::PointXYZ>& cloud, const std::st
     }
   if (worst > 2.0)
     throw Error(what + ": points are not a pinhole projection of their pixels (off by up to " +
-                std::to_string(static_cast<int>(worst)) + " px); give the intrinsics or a sensor-frame cloud");
+                (worst < 1e6 ? std::to_string(static_cast<int>(worst)) : std::string("1000000 or more")) +  // no int overflow
+                " px); give the intrinsics or a sensor-frame cloud");
   return cam;
 }
 
