@@ -157,6 +157,20 @@ void check_header(const std::filesystem::path& path, const std::string& what) {
     if (key == "DATA") { data = true; break; }
   }
   if (!data) bad("no DATA line in the header");
+  // PCL's header parser reads on past DATA while lines start with a header keyword: a body that begins
+  // like one (COLUMNS, FIELDS, ...) redefines the fields and PCL reads out of bounds (found by fuzz_pcd).
+  {
+    const std::streampos at = in.tellg();
+    std::string first;
+    std::getline(in, first);
+    std::istringstream words(first);
+    std::string token;
+    words >> token;
+    for (const char* key : {"VERSION", "FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"})
+      if (token.rfind(key, 0) == 0) bad("the body starts like a header line (" + printable(token) + ")");
+    in.clear();
+    in.seekg(at);
+  }
   const std::uintmax_t body_at = static_cast<std::uintmax_t>(in.tellg());
   const std::uintmax_t body = in.eof() || body_at > file_size ? 0 : file_size - body_at;
   for (const char* key : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT"})
