@@ -366,6 +366,8 @@ int run(const BenchOptions& o) {
       subsample_frame(frames.back(), o.subsample);
     } catch (const Error& e) {
       report_error(e.what());
+    } catch (const std::exception& e) {  // OpenCV, out of memory: the frame is skipped all the same
+      report_error(source.path(i).string() + ": " + e.what());
     }
   }
   if (frames.empty()) throw Error(o.dataset + ": no frame could be loaded");

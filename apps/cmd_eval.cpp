@@ -166,7 +166,8 @@ void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord&
       tracking.add(frame.label, out.labels);
       report.boundary_tolerance_px = boundary_tolerance_px(frame.label.size());  // one camera per set
       for (const auto& [stage, ms] : out.timings_ms) {
-        auto it = std::find_if(stage_sums.begin(), stage_sums.end(), [&](const auto& s) { return s.first == stage; });
+        auto it = std::find_if(stage_sums.begin(), stage_sums.end(),
+                               [&stage = stage](const auto& s) { return s.first == stage; });  // clang 14 (sanitizers)
         if (it == stage_sums.end()) it = stage_sums.insert(stage_sums.end(), {stage, {0.0, 0}});
         it->second.first += ms;
         ++it->second.second;

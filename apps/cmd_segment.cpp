@@ -82,6 +82,10 @@ int run(const SegmentOptions& o) {
       // A bad frame is reported and skipped; it never entered the temporal window.
       report_error(e.what());
       ++failed;
+    } catch (const std::exception& e) {
+      // Not the project's own error (OpenCV, out of memory, the file system): still one frame's problem.
+      report_error(source.path(i).string() + ": " + e.what());
+      ++failed;
     }
     progress.step(source.name(i));
   }

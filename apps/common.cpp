@@ -9,6 +9,7 @@
 
 #include "clutterseg/config.hpp"
 #include "clutterseg/io.hpp"
+#include "clutterseg/limits.hpp"
 #ifdef CLUTTERSEG_WITH_PCL
 #include "clutterseg/pcl/pcd.hpp"
 #endif
@@ -69,6 +70,7 @@ Params ParamOptions::resolve() const {
   if (no_temporal) p.smoothing.temporal = false;
   if (objects_only) p.support.objects_only = true;
   if (no_tracking) p.tracking.enabled = false;
+  validate(p);  // the flags' values too (the config file's were checked when it was read)
   return p;
 }
 
@@ -126,7 +128,11 @@ Frame FrameSource::load(size_t i) const {
   check_camera(*cam, f.depth.cols, f.depth.rows, e.depth.string());
   f.camera = *cam;
   if (e.color) {
-    f.color = cv::imread(e.color->string(), cv::IMREAD_COLOR);
+    try {
+      f.color = read_png(*e.color, cv::IMREAD_COLOR);
+    } catch (const Error&) {
+      f.color.release();  // a colour image is only decoration: one that cannot be read is left out
+    }
     if (f.color.size() != f.depth.size()) f.color.release();  // a colour image of another size is only decoration
   }
   if (e.label) {

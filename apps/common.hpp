@@ -50,6 +50,7 @@ class FrameSource {
   FrameSource(const fs::path& input, const CameraOptions& camera);
   size_t size() const { return entries_.size(); }
   const std::string& name(size_t i) const { return entries_[i].name; }
+  const fs::path& path(size_t i) const { return entries_[i].depth; }
   // Loads frame i; throws Error naming the file on any problem.
   Frame load(size_t i) const;
 

@@ -13,6 +13,9 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   chromium fonts-dejavu-core \
   python3 python3-numpy python3-matplotlib python3-opencv \
   pybind11-dev python3-dev python3-pytest python3-venv python3-build python3-setuptools python3-wheel >/dev/null
+# Sanitizer builds and fuzzers (scripts/sanitize.sh, scripts/fuzz.sh): clang 14 with its ASan, UBSan,
+# TSan and libFuzzer runtimes, and its OpenMP runtime.
+$SUDO apt-get install -y -qq --no-install-recommends clang-14 libclang-rt-14-dev libomp-14-dev >/dev/null
 # The ROS 1 node (ros/, docs/ROS.md): Debian's ROS 1 packages, message generation (gencpp, genpy and
 # the .msg files), master, launch, bags and rosrun to run it; rospy, OpenCV and pytest for the bag
 # script and the ROS tests.

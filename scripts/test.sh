@@ -5,3 +5,6 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 bash scripts/build.sh
 ctest --test-dir build --output-on-failure -j 2
+# Sanitizers (ASan+UBSan tree: fast tests and the CLI on every bad input; TSan on Segmenters in threads)
+# and every fuzzer for FUZZ_SECONDS (default 10): docs/RELIABILITY.md.
+bash scripts/sanitize.sh

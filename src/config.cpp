@@ -1,9 +1,12 @@
 #include "clutterseg/config.hpp"
 
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "clutterseg/limits.hpp"
 #include "clutterseg/types.hpp"
 
 namespace clutterseg {
@@ -26,11 +29,36 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params, smoothing, normals, edge
                                                 keep_freed_memory, tracking)
 
 namespace {
+// A value must have its default's type, and an integer must fit its field: converting 1e40 or 1.5 to
+// an int is undefined behaviour, and -1 as the uint64 seed would wrap.
+void check_type(const nlohmann::json& value, const nlohmann::json& known, const std::string& key,
+                const std::string& what) {
+  const auto fail = [&](const std::string& problem) {
+    std::string shown = value.dump();
+    if (shown.size() > 40) shown = shown.substr(0, 37) + "...";
+    throw Error(what + ": parameter '" + key + "' = " + shown + ": " + problem);
+  };
+  if (known.is_object() && !value.is_object()) fail("must be an object of parameters");
+  if (known.is_boolean() && !value.is_boolean()) fail("must be true or false");
+  if (known.is_number_float() && !value.is_number()) fail("must be a number");
+  if (known.is_number_integer() || known.is_number_unsigned()) {
+    if (!value.is_number_integer()) fail("must be an integer");  // also catches floats such as 1e40
+    if (known.is_number_unsigned()) {  // the seed
+      if (!value.is_number_unsigned()) fail("must be an integer in [0, 18446744073709551615]");
+    } else if (value.is_number_unsigned() ? value.get<std::uint64_t>() > std::numeric_limits<int>::max()
+                                          : (value.get<std::int64_t>() < std::numeric_limits<int>::min() ||
+                                             value.get<std::int64_t>() > std::numeric_limits<int>::max())) {
+      fail("is beyond the range of an int");
+    }
+  }
+}
+
 // Lists keys of `given` that the defaults do not have (typos would otherwise be ignored silently).
 void check_keys(const nlohmann::json& given, const nlohmann::json& known, const std::string& path,
                 const std::string& what) {
   for (const auto& [key, value] : given.items()) {
     if (!known.contains(key)) throw Error(what + ": unknown parameter '" + path + key + "'");
+    check_type(value, known.at(key), path + key, what);
     if (value.is_object()) check_keys(value, known.at(key), path + key + ".", what);
   }
 }
@@ -47,11 +75,18 @@ Params params_from_json(const std::string& text, const std::string& what) {
   }
   if (!j.is_object()) throw Error(what + ": parameters must be a JSON object");
   check_keys(j, nlohmann::json(Params{}), "", what);
+  Params params;
   try {
-    return j.get<Params>();
+    params = j.get<Params>();
   } catch (const std::exception& e) {
     throw Error(what + ": " + e.what());
   }
+  try {
+    validate(params);
+  } catch (const Error& e) {
+    throw Error(what + ": " + e.what());
+  }
+  return params;
 }
 
 Params read_params_file(const std::filesystem::path& path) {

@@ -1,10 +1,15 @@
 #include "clutterseg/io.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+
+#include "clutterseg/limits.hpp"
 
 namespace clutterseg {
 
@@ -45,20 +50,36 @@ Camera read_camera_json(const fs::path& path) {
   } catch (const std::exception& e) {
     fail(path, std::string("is not valid JSON (") + e.what() + ")");
   }
+  if (!j.is_object()) fail(path, "needs numbers fx, fy, cx, cy, width, height (is no JSON object)");
+  // Numbers are checked before they are converted: a float beyond an int's range (width 1e40) would be
+  // undefined behaviour.
+  const auto number = [&](const char* key) {
+    if (!j.contains(key) || !j.at(key).is_number())
+      fail(path, std::string("needs numbers fx, fy, cx, cy, width, height ('") + key + "' is missing or no number)");
+    const double v = j.at(key).get<double>();
+    if (!std::isfinite(v)) fail(path, std::string("'") + key + "' is not a finite number");
+    return v;
+  };
+  const auto size = [&](const char* key) {
+    if (!j.contains(key) || !j.at(key).is_number_integer())
+      fail(path, std::string("'") + key + "' must be a whole number of pixels");
+    const bool negative = j.at(key).is_number_integer() && !j.at(key).is_number_unsigned() && j.at(key).get<std::int64_t>() < 0;
+    if (negative || j.at(key).get<std::uint64_t>() > static_cast<std::uint64_t>(kMaxFrameSide))
+      fail(path, std::string("'") + key + "' = " + j.at(key).dump() + " is outside [1, " + std::to_string(kMaxFrameSide) + "]");
+    return static_cast<int>(j.at(key).get<std::int64_t>());
+  };
   Camera c;
-  try {
-    c.fx = j.at("fx").get<double>();
-    c.fy = j.at("fy").get<double>();
-    c.cx = j.at("cx").get<double>();
-    c.cy = j.at("cy").get<double>();
-    c.width = j.at("width").get<int>();
-    c.height = j.at("height").get<int>();
-    c.depth_unit_m = j.value("depth_unit_m", 0.001);
-  } catch (const std::exception& e) {
-    fail(path, std::string("needs numbers fx, fy, cx, cy, width, height (") + e.what() + ")");
-  }
+  c.fx = number("fx");
+  c.fy = number("fy");
+  c.cx = number("cx");
+  c.cy = number("cy");
+  c.width = size("width");
+  c.height = size("height");
+  if (j.contains("depth_unit_m")) c.depth_unit_m = number("depth_unit_m");
   if (!(c.fx > 0 && c.fy > 0 && c.width > 0 && c.height > 0 && c.depth_unit_m > 0))
     fail(path, "fx, fy, width, height and depth_unit_m must be positive");
+  if (!(c.depth_unit_m >= kMinDepthUnit && c.depth_unit_m <= kMaxDepthUnit))
+    fail(path, "depth_unit_m " + std::to_string(c.depth_unit_m) + " is outside [1e-6, 1] metres per step");
   return c;
 }
 
@@ -68,20 +89,54 @@ void write_camera_json(const fs::path& path, const Camera& c) {
   write_text_atomic(path, j.dump(1) + "\n");
 }
 
-cv::Mat read_depth_png(const fs::path& path) {
+cv::Mat read_png(const fs::path& path, int imread_flags) {
   if (!fs::exists(path)) fail(path, "no such file");
-  if (fs::is_directory(path)) fail(path, "is a folder, not a depth image");
-  cv::Mat depth = cv::imread(path.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
-  if (depth.empty()) fail(path, "cannot be read as an image");
+  if (fs::is_directory(path)) fail(path, "is a folder, not an image");
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  if (ext != ".png") fail(path, "is not a .png file (images are read as PNG only)");
+  std::error_code ec;
+  const auto bytes = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot be read (" + ec.message() + ")");
+  // The largest frame, stored uncompressed, with room for ancillary chunks.
+  constexpr std::uintmax_t kMaxBytes = static_cast<std::uintmax_t>(kMaxFramePixels) * 8 + (16u << 20);
+  if (bytes > kMaxBytes) fail(path, "is larger than any PNG frame clutterseg takes (" + std::to_string(bytes) + " bytes)");
+  std::vector<uchar> data(static_cast<size_t>(bytes));
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in || !in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(data.size())))
+      fail(path, "cannot be read");
+  }
+  // PNG signature, then the IHDR chunk (length 13) with width and height: checked here, so that no other
+  // decoder takes the bytes and no frame beyond the limits is allocated.
+  static constexpr uchar kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (data.size() < 33 || !std::equal(kSignature, kSignature + 8, data.begin()))
+    fail(path, "is not a PNG file (no PNG signature)");
+  if (!(data[8] == 0 && data[9] == 0 && data[10] == 0 && data[11] == 13 && std::equal(data.begin() + 12, data.begin() + 16, "IHDR")))
+    fail(path, "is not a valid PNG file (no IHDR chunk first)");
+  const auto be32 = [&](size_t at) {
+    return std::int64_t{data[at]} << 24 | std::int64_t{data[at + 1]} << 16 | std::int64_t{data[at + 2]} << 8 | data[at + 3];
+  };
+  check_frame_size(be32(16), be32(20), path.string());
+  cv::Mat image;
+  try {
+    image = cv::imdecode(data, imread_flags);
+  } catch (const cv::Exception& e) {
+    fail(path, "cannot be decoded as PNG (" + std::string(e.err) + ")");
+  }
+  if (image.empty()) fail(path, "cannot be decoded as PNG (damaged or truncated)");
+  return image;
+}
+
+cv::Mat read_depth_png(const fs::path& path) {
+  cv::Mat depth = read_png(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
   if (depth.type() != CV_16UC1)
     fail(path, "is a " + type_name(depth) + " image; depth must be a 16-bit single-channel PNG");
   return depth;
 }
 
 cv::Mat read_label_png(const fs::path& path) {
-  if (!fs::exists(path)) fail(path, "no such file");
-  cv::Mat labels = cv::imread(path.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
-  if (labels.empty()) fail(path, "cannot be read as an image");
+  cv::Mat labels = read_png(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
   if (labels.channels() != 1 || (labels.depth() != CV_16U && labels.depth() != CV_8U))
     fail(path, "is a " + type_name(labels) + " image; labels must be a single-channel 8- or 16-bit PNG");
   cv::Mat out;

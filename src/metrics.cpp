@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <unordered_map>
@@ -54,10 +55,6 @@ Objects collect_objects(const cv::Mat& labels) {
 double ratio(double a, double b, double empty) { return b > 0 ? a / b : empty; }
 double harmonic(double p, double r) { return p + r > 0 ? 2 * p * r / (p + r) : 0.0; }
 
-// Pixels of `boundaries` that belong to object `id`, inside `roi`.
-cv::Mat object_boundary(const cv::Mat& labels, const cv::Mat& boundaries, int id, const cv::Rect& roi) {
-  return (labels(roi) == id) & boundaries(roi);
-}
 
 }  // namespace
 
@@ -159,6 +156,113 @@ std::vector<int> max_weight_assignment(const std::vector<std::vector<double>>& w
   return row_to_col;
 }
 
+namespace {
+
+// One nonzero cell of the contingency table: |R_i & S_j| > 0 (indices into the Objects).
+struct Overlap {
+  int i, j;
+  double pixels;
+};
+
+// The nonzero cells of the contingency table in (i, j) order, from one pass over the pixels: runs of
+// one pair are counted together, then the runs are sorted and merged. O(pixels + runs log runs),
+// whatever the number of ids (a dense n x m table took 65535 x 65535 cells for 65535 ids).
+std::vector<Overlap> overlaps(const cv::Mat& gt, const cv::Mat& pred, const Objects& g, const Objects& p) {
+  std::vector<std::pair<std::uint64_t, long>> runs;
+  for (int y = 0; y < gt.rows; ++y) {
+    const int* gr = gt.ptr<int>(y);
+    const int* pr = pred.ptr<int>(y);
+    std::uint64_t last = ~std::uint64_t{0};
+    for (int x = 0; x < gt.cols; ++x) {
+      if (gr[x] == 0 || pr[x] == 0) continue;
+      const std::uint64_t key = std::uint64_t(std::uint32_t(gr[x])) << 32 | std::uint32_t(pr[x]);
+      if (key == last) {
+        ++runs.back().second;
+      } else {
+        runs.emplace_back(key, 1);
+        last = key;
+      }
+    }
+  }
+  std::sort(runs.begin(), runs.end());
+  std::vector<Overlap> out;
+  for (size_t k = 0; k < runs.size();) {
+    long sum = 0;
+    size_t e = k;
+    for (; e < runs.size() && runs[e].first == runs[k].first; ++e) sum += runs[e].second;
+    const int gid = static_cast<int>(std::uint32_t(runs[k].first >> 32)), pid = static_cast<int>(std::uint32_t(runs[k].first));
+    out.push_back({g.index.at(gid), p.index.at(pid), double(sum)});
+    k = e;
+  }
+  // Ids compare as signed ints in the Objects, as unsigned in the keys: order by index.
+  std::sort(out.begin(), out.end(), [](const Overlap& a, const Overlap& b) { return a.i != b.i ? a.i < b.i : a.j < b.j; });
+  return out;
+}
+
+// Maximum-weight one-to-one matching over the overlapping pairs only (a pair without overlap scores 0
+// and is never counted). The pairs fall apart into connected components, each solved alone: exactly
+// (Hungarian on the component's rows x columns) while that costs at most kExactWork steps, greedily
+// (heaviest pair first) beyond, which no real frame reaches. Returns, per ground-truth object, the
+// matched prediction or -1. Bounded by the pixels: at most one pair per pixel.
+std::vector<int> match_overlaps(int n, int m, const std::vector<Overlap>& pairs, const std::vector<double>& weight) {
+  constexpr double kExactWork = 2e8;
+  std::vector<int> parent(static_cast<size_t>(n + m));
+  for (size_t k = 0; k < parent.size(); ++k) parent[k] = static_cast<int>(k);
+  const auto find = [&](int v) {
+    while (parent[static_cast<size_t>(v)] != v) v = parent[static_cast<size_t>(v)] = parent[static_cast<size_t>(parent[static_cast<size_t>(v)])];
+    return v;
+  };
+  for (const Overlap& o : pairs) parent[static_cast<size_t>(find(o.i))] = find(n + o.j);
+  std::unordered_map<int, std::vector<size_t>> component;  // root -> its pairs
+  for (size_t k = 0; k < pairs.size(); ++k) component[find(pairs[k].i)].push_back(k);
+  std::vector<int> roots;
+  for (const auto& [root, list] : component) roots.push_back(root);
+  std::sort(roots.begin(), roots.end());  // the same order on every run
+
+  std::vector<int> match(static_cast<size_t>(n), -1);
+  std::vector<int> row_of(static_cast<size_t>(n), -1), col_of(static_cast<size_t>(m), -1);
+  for (int root : roots) {
+    const std::vector<size_t>& list = component[root];
+    std::vector<int> rows, cols;
+    for (size_t k : list) {
+      const Overlap& o = pairs[k];
+      if (row_of[static_cast<size_t>(o.i)] < 0) { row_of[static_cast<size_t>(o.i)] = static_cast<int>(rows.size()); rows.push_back(o.i); }
+      if (col_of[static_cast<size_t>(o.j)] < 0) { col_of[static_cast<size_t>(o.j)] = static_cast<int>(cols.size()); cols.push_back(o.j); }
+    }
+    const double r = double(rows.size()), c = double(cols.size());
+    if (std::min(r, c) * std::min(r, c) * std::max(r, c) <= kExactWork && r * c <= double(1 << 24)) {
+      std::vector<std::vector<double>> w(rows.size(), std::vector<double>(cols.size(), 0.0));
+      for (size_t k : list) w[static_cast<size_t>(row_of[static_cast<size_t>(pairs[k].i)])][static_cast<size_t>(col_of[static_cast<size_t>(pairs[k].j)])] = weight[k];
+      const std::vector<int> assigned = max_weight_assignment(w);
+      for (size_t a = 0; a < rows.size(); ++a)
+        if (assigned[a] >= 0) match[static_cast<size_t>(rows[a])] = cols[static_cast<size_t>(assigned[a])];
+    } else {
+      std::vector<size_t> order = list;
+      std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return weight[a] > weight[b]; });
+      std::vector<char> used(cols.size(), 0);
+      for (size_t k : order) {
+        const Overlap& o = pairs[k];
+        const auto col = static_cast<size_t>(col_of[static_cast<size_t>(o.j)]);
+        if (match[static_cast<size_t>(o.i)] >= 0 || used[col]) continue;
+        match[static_cast<size_t>(o.i)] = o.j;
+        used[col] = 1;
+      }
+    }
+    // Drop a matching of zero weight (a row given a column it does not overlap).
+    for (int i : rows) {
+      int& j = match[static_cast<size_t>(i)];
+      if (j < 0) continue;
+      const auto it = std::lower_bound(list.begin(), list.end(), std::make_pair(i, j), [&](size_t k, const std::pair<int, int>& key) {
+        return std::make_pair(pairs[k].i, pairs[k].j) < key;
+      });
+      if (it == list.end() || pairs[*it].i != i || pairs[*it].j != j || !(weight[*it] > 0)) j = -1;
+    }
+  }
+  return match;
+}
+
+}  // namespace
+
 FrameScores score_frame(const cv::Mat& ground_truth, const cv::Mat& prediction) {
   const cv::Mat gt = as_labels(ground_truth, "ground truth");
   const cv::Mat pred = as_labels(prediction, "prediction");
@@ -173,75 +277,90 @@ FrameScores score_frame(const cv::Mat& ground_truth, const cv::Mat& prediction) 
   if (s.gt_objects == 0) return s;  // nothing to find: every score stays undefined
   const int n = s.gt_objects, m = s.pred_objects;
 
-  // Contingency table of object pixels: intersection[i][j] = |R_i & S_j|.
-  std::vector<std::vector<double>> intersection(n, std::vector<double>(m, 0.0));
-  if (m > 0) {
-    for (int y = 0; y < gt.rows; ++y) {
-      const int* gr = gt.ptr<int>(y);
-      const int* pr = pred.ptr<int>(y);
-      for (int x = 0; x < gt.cols; ++x)
-        if (gr[x] != 0 && pr[x] != 0) intersection[g.index[gr[x]]][p.index[pr[x]]] += 1;
-    }
-  }
+  // Contingency table of object pixels, its nonzero cells only: |R_i & S_j| per overlapping pair.
+  const std::vector<Overlap> pairs = overlaps(gt, pred, g, p);
 
-  // Paper: the segment with the largest overlap per ground-truth object.
+  // Paper: the segment with the largest overlap per ground-truth object (smallest id on ties).
   double tp_sum = 0, fp_sum = 0;
-  for (int i = 0; i < n; ++i) {
-    int best = -1;
-    for (int j = 0; j < m; ++j)
-      if (intersection[i][j] > 0 && (best < 0 || intersection[i][j] > intersection[i][best])) best = j;
-    if (best < 0) continue;  // missed: tp_i = 0, and no segment to be wrong (fp_i = 0)
-    tp_sum += intersection[i][best] / g.area[i];
-    fp_sum += (p.area[best] - intersection[i][best]) / p.area[best];
-  }
+  for (size_t k = 0; k < pairs.size();) {
+    size_t best = k, e = k;
+    for (; e < pairs.size() && pairs[e].i == pairs[k].i; ++e)
+      if (pairs[e].pixels > pairs[best].pixels) best = e;
+    const Overlap& o = pairs[best];
+    tp_sum += o.pixels / g.area[static_cast<size_t>(o.i)];
+    fp_sum += (p.area[static_cast<size_t>(o.j)] - o.pixels) / p.area[static_cast<size_t>(o.j)];
+    k = e;
+  }  // a missed object (no overlap) adds 0 to both
   s.tp = tp_sum / n;
   s.fp = fp_sum / n;
   s.fn = 1.0 - s.tp;
 
   // UOIS: pairwise F, one-to-one matching maximising its sum; pairs without overlap do not count.
-  std::vector<std::vector<double>> pair_f(n, std::vector<double>(m, 0.0));
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < m; ++j) pair_f[i][j] = 2 * intersection[i][j] / double(g.area[i] + p.area[j]);
-  const std::vector<int> match = m > 0 ? max_weight_assignment(pair_f) : std::vector<int>(n, -1);
+  std::vector<double> pair_f(pairs.size());
+  for (size_t k = 0; k < pairs.size(); ++k)
+    pair_f[k] = 2 * pairs[k].pixels / double(g.area[static_cast<size_t>(pairs[k].i)] + p.area[static_cast<size_t>(pairs[k].j)]);
+  const std::vector<int> match = match_overlaps(n, m, pairs, pair_f);
 
   long gt_pixels = 0, pred_pixels = 0;
   for (long a : g.area) gt_pixels += a;
   for (long a : p.area) pred_pixels += a;
   double matched_pixels = 0;
   int detected = 0;
-  for (int i = 0; i < n; ++i) {
-    if (match[i] < 0 || pair_f[i][match[i]] <= 0) continue;
+  std::vector<int> gt_of_pred(static_cast<size_t>(m), -1);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const Overlap& o = pairs[k];
+    if (match[static_cast<size_t>(o.i)] != o.j) continue;
     ++s.matched;
-    s.matches.emplace_back(g.ids[i], p.ids[match[i]]);
-    matched_pixels += intersection[i][match[i]];
-    if (pair_f[i][match[i]] > 0.75) ++detected;
+    s.matches.emplace_back(g.ids[static_cast<size_t>(o.i)], p.ids[static_cast<size_t>(o.j)]);
+    gt_of_pred[static_cast<size_t>(o.j)] = o.i;
+    matched_pixels += o.pixels;
+    if (pair_f[k] > 0.75) ++detected;
   }
   s.overlap_p = ratio(matched_pixels, double(pred_pixels), 0.0);
   s.overlap_r = ratio(matched_pixels, double(gt_pixels), 0.0);
   s.overlap_f = harmonic(s.overlap_p, s.overlap_r);
   s.detected_75 = double(detected) / n;
 
-  // Boundary P/R: a predicted boundary pixel is right when a matched ground-truth boundary lies within
-  // the tolerance disk, and vice versa for recall.
+  // Boundary P/R: a predicted boundary pixel is right when a boundary pixel of its matched ground-truth
+  // object lies within the tolerance disk, and vice versa for recall. Per boundary pixel, a look at
+  // the disk around it: O(pixels x disk), however many objects there are.
   const cv::Mat gt_edges = object_boundaries(gt), pred_edges = object_boundaries(pred);
   const long gt_boundary = cv::countNonZero(gt_edges), pred_boundary = cv::countNonZero(pred_edges);
   const int radius = boundary_tolerance_px(gt.size());
   const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
-  const cv::Rect image(0, 0, gt.cols, gt.rows);
-  double pred_hits = 0, gt_hits = 0;
-  for (int i = 0; i < n; ++i) {
-    if (match[i] < 0 || pair_f[i][match[i]] <= 0) continue;
-    const int j = match[i];
-    cv::Rect roi = g.bbox[i] | p.bbox[j];
-    roi = cv::Rect(roi.x - radius, roi.y - radius, roi.width + 2 * radius, roi.height + 2 * radius) & image;
-    const cv::Mat gb = object_boundary(gt, gt_edges, g.ids[i], roi);
-    const cv::Mat pb = object_boundary(pred, pred_edges, p.ids[j], roi);
-    cv::Mat gb_wide, pb_wide;
-    cv::dilate(gb, gb_wide, disk, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-    cv::dilate(pb, pb_wide, disk, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-    pred_hits += cv::countNonZero(pb & gb_wide);
-    gt_hits += cv::countNonZero(gb & pb_wide);
-  }
+  std::vector<cv::Point> offsets;
+  for (int dy = 0; dy < disk.rows; ++dy)
+    for (int dx = 0; dx < disk.cols; ++dx)
+      if (disk.at<uchar>(dy, dx)) offsets.emplace_back(dx - radius, dy - radius);
+  std::vector<int> pred_of_gt(static_cast<size_t>(n), -1);
+  for (int i = 0; i < n; ++i) pred_of_gt[static_cast<size_t>(i)] = match[static_cast<size_t>(i)];
+  // Boundary pixels of `edges_a` (labels `a`) whose matched object has a boundary pixel of `edges_b`
+  // (labels `b`) within the disk.
+  const auto hits = [&](const cv::Mat& a, const cv::Mat& edges_a, const Objects& oa, const std::vector<int>& partner,
+                        const cv::Mat& b, const cv::Mat& edges_b, const Objects& ob) {
+    double count = 0;
+    for (int y = 0; y < a.rows; ++y) {
+      const uchar* e = edges_a.ptr<uchar>(y);
+      const int* la = a.ptr<int>(y);
+      for (int x = 0; x < a.cols; ++x) {
+        if (!e[x]) continue;
+        const int other = partner[static_cast<size_t>(oa.index.at(la[x]))];
+        if (other < 0) continue;
+        const int want = ob.ids[static_cast<size_t>(other)];
+        for (const cv::Point& o : offsets) {
+          const int qx = x + o.x, qy = y + o.y;
+          if (qx < 0 || qy < 0 || qx >= b.cols || qy >= b.rows) continue;
+          if (edges_b.at<uchar>(qy, qx) && b.at<int>(qy, qx) == want) {
+            ++count;
+            break;
+          }
+        }
+      }
+    }
+    return count;
+  };
+  const double pred_hits = hits(pred, pred_edges, p, gt_of_pred, gt, gt_edges, g);
+  const double gt_hits = hits(gt, gt_edges, g, pred_of_gt, pred, pred_edges, p);
   // An object filling the whole image has no boundary; with nothing to miss on either side, score 1.
   const double none_to_miss = (gt_boundary == 0 && pred_boundary == 0 && s.matched > 0) ? 1.0 : 0.0;
   s.boundary_p = ratio(pred_hits, double(pred_boundary), none_to_miss);

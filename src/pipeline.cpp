@@ -12,20 +12,12 @@
 #include <mutex>
 #include <thread>
 
+#include "clutterseg/limits.hpp"
 #include "clutterseg/parallel.hpp"
 
 namespace clutterseg {
 
 namespace {
-
-// The validation Segmenter::segment does first: a bad frame throws before it enters the window.
-cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
-  if (depth.empty()) throw Error("depth image is empty");
-  check_camera(camera, depth.cols, depth.rows, "camera");
-  cv::Mat metres = depth_to_metres(depth, camera);
-  if (cv::countNonZero(metres) == 0) throw Error("depth image has no valid measurement");
-  return metres;
-}
 
 double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -152,6 +144,7 @@ struct Pipeline::State {
 };
 
 Pipeline::Pipeline(Params params) : state_(std::make_unique<State>()) {
+  validate(params);  // as Segmenter's constructor: every parameter within its range (limits.hpp)
   State& s = *state_;
   if (params.keep_freed_memory) keep_freed_memory();
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

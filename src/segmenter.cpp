@@ -7,6 +7,7 @@
 #include "clutterseg/cutfree.hpp"
 #include "clutterseg/edges.hpp"
 #include "clutterseg/graph_cut.hpp"
+#include "clutterseg/limits.hpp"
 #include "clutterseg/normals.hpp"
 #include "clutterseg/objects.hpp"
 #include "clutterseg/parallel.hpp"
@@ -52,13 +53,6 @@ std::vector<PatchPair> without_table_links(std::vector<PatchPair> pairs, const s
   return pairs;
 }
 
-cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
-  if (depth.empty()) throw Error("depth image is empty");
-  check_camera(camera, depth.cols, depth.rows, "camera");
-  cv::Mat metres = depth_to_metres(depth, camera);
-  if (cv::countNonZero(metres) == 0) throw Error("depth image has no valid measurement");
-  return metres;
-}
 
 }  // namespace
 
@@ -74,6 +68,7 @@ void keep_freed_memory() {
 }
 
 Segmenter::Segmenter(Params params) : params_(std::move(params)), tracker_(params_.tracking) {
+  validate(params_);  // every parameter within its documented range (limits.hpp)
   if (params_.keep_freed_memory) keep_freed_memory();
 }
 

@@ -114,6 +114,14 @@ CLUTTERSEG_AVX2_KERNEL void mark_hole_borders(const float* __restrict up, const 
 
 }  // namespace
 
+cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera) {
+  if (depth.empty()) throw Error("depth image is empty");
+  check_camera(camera, depth.cols, depth.rows, "camera");
+  cv::Mat metres = depth_to_metres(depth, camera);
+  if (cv::countNonZero(metres) == 0) throw Error("depth image has no valid measurement");
+  return metres;
+}
+
 cv::Mat median_depth(const cv::Mat& depth) {
   // OpenCV's median (SIMD) for the bulk. Pixels within one pixel of a hole or of the image border
   // (OpenCV replicates the border) are redone over their valid neighbours only, so that missing data

@@ -14,6 +14,10 @@ namespace fs = std::filesystem;
 Camera read_camera_json(const fs::path& path);
 void write_camera_json(const fs::path& path, const Camera& camera);
 
+// A .png file decoded as PNG only (signature and IHDR checked first, frame size within limits.hpp);
+// imread_flags as for cv::imread. Throws Error naming the file for anything else.
+cv::Mat read_png(const fs::path& path, int imread_flags);
+
 // 16-bit single-channel PNG depth; throws Error naming the file for anything else.
 cv::Mat read_depth_png(const fs::path& path);
 

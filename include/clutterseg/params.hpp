@@ -147,9 +147,12 @@ struct Params {
 // Pixel sizes in Params are for the paper's camera: a 320x240 Kinect v1, fx = fy = 262.5 px. They are
 // scaled by the angular resolution sqrt(fx * fy) / 262.5, so that a window covers the same field of
 // view on any sensor and resolution (x2 for a 640x480 Kinect, x4 for YCB-Video's Xtion at fx = 1067).
+// The factor is capped at kMax (fx = 8400 px; check_camera bounds the field of view besides), so that no
+// focal length makes a kernel or a search window grow without bound.
 struct PixelScale {
+  static constexpr double kMax = 32;
   double factor = 1;
-  PixelScale(double fx, double fy) : factor(std::sqrt(fx * fy) / 262.5) {}
+  PixelScale(double fx, double fy) : factor(std::min(kMax, std::sqrt(fx * fy) / 262.5)) {}
   int length(double px) const { return std::max(1, static_cast<int>(std::lround(px * factor))); }
   int area(double px) const { return std::max(1, static_cast<int>(std::lround(px * factor * factor))); }
   int odd(int ksize) const { return 2 * static_cast<int>(std::lround((ksize - 1) / 2.0 * factor)) + 1; }

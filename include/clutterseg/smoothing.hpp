@@ -12,6 +12,10 @@ namespace clutterseg {
 // metres with 0 = none. Throws Error if the type is neither.
 cv::Mat depth_to_metres(const cv::Mat& depth, const Camera& camera);
 
+// The validation every frame gets first (Segmenter, Pipeline): a non-empty depth image whose intrinsics fit
+// (check_camera) and that holds at least one valid measurement; returned in metres. Throws Error.
+cv::Mat checked_metres(const cv::Mat& depth, const Camera& camera);
+
 // 3x3 median over the valid neighbours of each valid pixel; invalid pixels stay invalid.
 cv::Mat median_depth(const cv::Mat& depth);
 
