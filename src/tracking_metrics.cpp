@@ -1,5 +1,6 @@
 #include "clutterseg/tracking_metrics.hpp"
 
+#include <limits>
 #include <vector>
 
 namespace clutterseg {
@@ -58,9 +59,11 @@ void TrackingScorer::add(const cv::Mat& ground_truth, const cv::Mat& prediction)
     ++scores_.object_frames;
     if (seen_.insert(g).second) ++scores_.objects;
     int match = 0;
-    for (const auto& [p, p_area] : pred_area) {
-      const auto it = pairs.find({g, p});
-      if (it == pairs.end()) continue;
+    // Only the predictions that overlap g (the pairs are sorted by g): bounded by the pixels, not the ids.
+    for (auto it = pairs.lower_bound({g, std::numeric_limits<int>::min()}); it != pairs.end() && it->first.first == g; ++it) {
+      const int p = it->first.second;
+      if (p == 0) continue;
+      const long p_area = pred_area.at(p);
       const double iou = static_cast<double>(it->second) / static_cast<double>(area + p_area - it->second);
       if (iou > 0.5) match = p;  // at most one: IoU > 0.5 is one-to-one
     }
