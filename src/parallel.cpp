@@ -65,12 +65,13 @@ namespace {
 // free_cores(), clamped to [1, cores], re-read at most every 10 ms (a read costs a few microseconds; a
 // frame has ~10 regions).
 int cached_free_cores() {
-  static std::atomic<std::int64_t> read_at{std::numeric_limits<std::int64_t>::min()};
+  constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
+  static std::atomic<std::int64_t> read_at{kNever};
   static std::atomic<int> cached{1};
   const std::int64_t now = Clock::now().time_since_epoch().count();
   constexpr std::int64_t kRefresh = std::chrono::duration_cast<Clock::duration>(std::chrono::milliseconds(10)).count();
   std::int64_t last = read_at.load(std::memory_order_relaxed);
-  if (now - last >= kRefresh && read_at.compare_exchange_strong(last, now))
+  if ((last == kNever || now - last >= kRefresh) && read_at.compare_exchange_strong(last, now))  // no overflow
     cached.store(std::clamp(free_cores(), 1, cores()), std::memory_order_relaxed);
   return cached.load(std::memory_order_relaxed);
 }
