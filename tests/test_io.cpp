@@ -13,14 +13,6 @@ using namespace clutterseg::testing_cli;
 namespace {
 const fs::path kData = CLUTTERSEG_DATA_DIR;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 }  // namespace
 
 TEST(Io, ReadsEveryDevDataset) {

@@ -42,14 +42,6 @@ void expect_refused(const CliRun& r, const std::string& names, const std::string
   EXPECT_FALSE(fs::exists(out) && !fs::is_empty(out)) << what << ": wrote output";
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 }  // namespace
 
 TEST(Reliability, FuzzedPcdFilesAreRefusedBeforePclReadsThem) {

@@ -133,6 +133,14 @@ cv::Vec3b random_colour(Rng& rng) {
 
 enum class Kind { Box, Book, Standing, Lying, Sphere, Bowl, Cup };
 
+// A box's size in all the places an Item keeps it: full extents (x, y, z) [m].
+void size_box(Item& box, const Vector3d& full) {
+  box.shape.size = full / 2;
+  box.info.size = full;
+  box.footprint.half = full.head<2>() / 2;
+  box.top = full.z();
+}
+
 // A randomly sized object of `kind`, not yet placed (footprint centred at the origin).
 Item make_item(Kind kind, Rng& rng) {
   Item it;
@@ -145,11 +153,8 @@ Item make_item(Kind kind, Rng& rng) {
           ? Vector3d(rng.uniform(0.05, 0.2), rng.uniform(0.05, 0.16), rng.uniform(0.04, 0.16))
           : Vector3d(rng.uniform(0.16, 0.26), rng.uniform(0.11, 0.18), rng.uniform(0.02, 0.045));
       s.type = ShapeType::Box;
-      s.size = full / 2;
+      size_box(it, full);
       it.info.type = kind == Kind::Box ? "box" : "book";
-      it.info.size = full;
-      it.footprint.half = full.head<2>() / 2;
-      it.top = full.z();
       it.flat_top = true;
       break;
     }
@@ -294,10 +299,7 @@ bool place_occluder(std::vector<Item>& items, int behind, const Layout& lay, Rng
     const double eye_height = lay.eye.z(), reach = (lay.eye.head<2>() - back.footprint.centre).norm() + depth;
     const double aim = cover * back.top, run = d + depth;
     const double h = std::clamp((aim * (reach - run) + eye_height * run) / std::max(reach, 1e-3), back.top * 1.1, 0.45);
-    occ.shape.size = {w / 2, w / 2, h / 2};
-    occ.info.size = {w, w, h};
-    occ.footprint.half = {w / 2, w / 2};
-    occ.top = h;
+    size_box(occ, {w, w, h});
     occ.base = 0;
     const Vector2d xy = back.footprint.centre + d * lay.toward_camera + rng.uniform(-0.02, 0.02) * lay.across;
     const double yaw = std::atan2(lay.across.y(), lay.across.x()) + rng.uniform(-0.3, 0.3);
@@ -345,16 +347,10 @@ bool build_pick_and_place(std::vector<Item>& items, const Layout& lay, Rng& rng)
   const double yaw_across = std::atan2(lay.across.y(), lay.across.x());
   Item tall = make_item(Kind::Box, rng);
   const double w = rng.uniform(0.045, 0.06), h = rng.uniform(0.16, 0.2);
-  tall.shape.size = {w / 2, w / 2, h / 2};
-  tall.info.size = {w, w, h};
-  tall.footprint.half = {w / 2, w / 2};
-  tall.top = h;
+  size_box(tall, {w, w, h});
   Item mover = make_item(Kind::Box, rng);
   const Vector3d full(rng.uniform(0.05, 0.07), rng.uniform(0.04, 0.06), rng.uniform(0.05, 0.08));
-  mover.shape.size = full / 2;
-  mover.info.size = full;
-  mover.footprint.half = full.head<2>() / 2;
-  mover.top = full.z();
+  size_box(mover, full);
   const Kind kinds[] = {Kind::Box, Kind::Standing, Kind::Sphere, Kind::Cup};
   Item first = small_item(kinds[rng.integer(0, 3)], rng), carried = small_item(rng.chance(0.5) ? Kind::Box : Kind::Standing, rng);
   Item last = small_item(kinds[rng.integer(0, 3)], rng);
@@ -406,10 +402,7 @@ bool build(const std::string& preset, std::vector<Item>& items, const Layout& la
   if (preset == "occluded-box") {
     Item box = make_item(Kind::Box, rng);
     const Vector3d full(rng.uniform(0.2, 0.3), rng.uniform(0.06, 0.1), rng.uniform(0.07, 0.13));
-    box.shape.size = full / 2;
-    box.info.size = full;
-    box.footprint.half = full.head<2>() / 2;
-    box.top = full.z();
+    size_box(box, full);
     return place_on_table(box, items, lay, rng, 0, lay.centre - 0.04 * lay.toward_camera, yaw_across + rng.uniform(-0.2, 0.2)) &&
            place_occluder(items, 0, lay, rng);
   }
