@@ -31,8 +31,7 @@ namespace {
 constexpr int kMaxSeeds = 4;
 
 // A seed is a patch pixel, named by its image position and carrying its label; its 3D point is read
-// from the cloud when a distance is needed (it lies within r pixels, so in cache). 12 bytes: the seed
-// sets of all carriers of a 640x480 frame take about 3 MB.
+// from the cloud when a distance is needed (it lies within r pixels, so in cache).
 struct Seed {
   std::uint32_t yx;  // (y << 16) | x: one compare tells two seeds apart, and orders them as pixel indices
   int label;         // patch id 1..N
@@ -42,41 +41,48 @@ struct Seed {
 
 std::uint32_t pack(int x, int y) { return static_cast<std::uint32_t>(y) << 16 | static_cast<std::uint32_t>(x); }
 
-// Strict order on seeds competing for one slot: nearer first, ties to the smaller pixel index, so that
-// the result does not depend on the order neighbours are visited.
-bool nearer(const Seed& a, const Seed& b) { return a.d2 < b.d2 || (a.d2 == b.d2 && a.yx < b.yx); }
+// The yx of an empty slot: no pixel of a frame has it (frames are at most kMaxFrameSide wide).
+constexpr std::uint32_t kNoSeed = 0xffffffffu;
 
+// The seeds a pixel holds, stored as arrays (52 bytes; the sets of all carriers of a 640x480 frame take
+// about 2 MB). Most of the work is asking whether a seed is held already: four compares without a
+// branch (empty slots hold kNoSeed), instead of a loop whose exit a CPU cannot predict.
 struct SeedSet {
-  Seed seed[kMaxSeeds];
+  std::uint32_t yx[kMaxSeeds];
+  int label[kMaxSeeds];
+  float d2[kMaxSeeds];
   int count;
-  SeedSet() : count(0) {}  // user-provided: a vector of SeedSets is not zero-filled first
-  // Offers a seed: keeps the nearest seed per label and the kMaxSeeds nearest labels. Neighbours mostly
-  // pass on a seed this set already holds; that case returns before any distance is computed.
-  // `distance2` gives d2 for the candidate; seeds at `limit` or farther are not kept.
-  // `within` tells whether the candidate is within the search radius: asked only for a seed not held
-  // already (a held seed passed it, and a pixel has one label, so equal yx means the same seed).
+  SeedSet() : count(0) { std::fill(yx, yx + kMaxSeeds, kNoSeed); }
+  bool holds(std::uint32_t pixel) const {
+    static_assert(kMaxSeeds == 4, "holds() compares four slots");
+    return (yx[0] == pixel) | (yx[1] == pixel) | (yx[2] == pixel) | (yx[3] == pixel);
+  }
+  Seed at(int i) const { return {yx[i], label[i], d2[i]}; }
+  void put(int i, const Seed& s) { yx[i] = s.yx; label[i] = s.label; d2[i] = s.d2; }
+  // Offers a seed not held yet: keeps the nearest seed per label and the kMaxSeeds nearest labels.
+  // `within` tells whether the candidate is within the search radius, `distance2` gives its d2; seeds
+  // at `limit` or farther are not kept. Ties go to the smaller pixel index or label, so that the result
+  // does not depend on the order neighbours are visited.
   template <typename Within, typename Distance2>
-  void offer(std::uint32_t yx, int label, Within within, Distance2 distance2, float limit) {
-    for (int i = 0; i < count; ++i)
-      if (seed[i].yx == yx) return;
+  void offer(std::uint32_t pixel, int seed_label, Within within, Distance2 distance2, float limit) {
     if (!within()) return;
     int slot = -1;
     for (int i = 0; i < count; ++i)
-      if (seed[i].label == label) {
+      if (label[i] == seed_label) {
         slot = i;
         break;
       }
-    const Seed s{yx, label, distance2()};
+    const Seed s{pixel, seed_label, distance2()};
     if (s.d2 >= limit) return;
     if (slot >= 0) {
-      if (nearer(s, seed[slot])) seed[slot] = s;
+      if (s.d2 < d2[slot] || (s.d2 == d2[slot] && s.yx < yx[slot])) put(slot, s);
       return;
     }
-    if (count < kMaxSeeds) { seed[count++] = s; return; }
+    if (count < kMaxSeeds) { put(count++, s); return; }
     int worst = 0;
     for (int i = 1; i < count; ++i)
-      if (seed[i].d2 > seed[worst].d2 || (seed[i].d2 == seed[worst].d2 && seed[i].label > seed[worst].label)) worst = i;
-    if (s.d2 < seed[worst].d2 || (s.d2 == seed[worst].d2 && s.label < seed[worst].label)) seed[worst] = s;
+      if (d2[i] > d2[worst] || (d2[i] == d2[worst] && label[i] > label[worst])) worst = i;
+    if (s.d2 < d2[worst] || (s.d2 == d2[worst] && s.label < label[worst])) put(worst, s);
   }
 };
 
@@ -161,14 +167,12 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     auto visit = [&](int j, int xx, int yy) {
       const int neighbour = role[static_cast<size_t>(j)];
       if (neighbour == kSource) {
-        offer(pack(xx, yy), lab[j]);
+        const std::uint32_t yx = pack(xx, yy);
+        if (!own.holds(yx)) offer(yx, lab[j]);
       } else if (neighbour >= 0) {
         const SeedSet& other = seeds[static_cast<size_t>(neighbour)];
-        for (int s = 0; s < other.count; ++s) {
-          const Seed& t = other.seed[s];
-          if (s < own.count && own.seed[s].yx == t.yx) continue;  // held, in the same slot: nothing to do
-          offer(t.yx, t.label);
-        }
+        for (int s = 0; s < other.count; ++s)  // neighbours mostly pass on seeds held already
+          if (!own.holds(other.yx[s])) offer(other.yx[s], other.label[s]);
       }
     };
     // Most carriers are inside the image: their four neighbours need no border test (same order).
@@ -193,20 +197,19 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     const SeedSet& own = seeds[k];
     int near[kMaxSeeds], count = 0, best = -1;
     for (int s = 0; s < own.count; ++s) {
-      if (own.seed[s].d2 >= d2_max) continue;
+      if (own.d2[s] >= d2_max) continue;
       near[count++] = s;
-      if (best < 0 || own.seed[s].d2 < own.seed[best].d2 ||
-          (own.seed[s].d2 == own.seed[best].d2 && own.seed[s].label < own.seed[best].label)) best = s;
+      if (best < 0 || own.d2[s] < own.d2[best] || (own.d2[s] == own.d2[best] && own.label[s] < own.label[best]))
+        best = s;
     }
     if (best < 0) continue;
-    assigned[i] = own.seed[best].label;
+    assigned[i] = own.label[best];
     for (int a = 0; a < count; ++a)
       for (int b = a + 1; b < count; ++b) {
-        const Seed* sa = &own.seed[near[a]];
-        const Seed* sb = &own.seed[near[b]];
-        if (sa->label > sb->label) std::swap(sa, sb);
+        Seed sa = own.at(near[a]), sb = own.at(near[b]);
+        if (sa.label > sb.label) std::swap(sa, sb);
         const auto pixel = [width](const Seed& s) { return static_cast<int>(s.yx >> 16) * width + static_cast<int>(s.yx & 0xffff); };
-        out.contacts.push_back({sa->label - 1, sb->label - 1, pixel(*sa), pixel(*sb)});
+        out.contacts.push_back({sa.label - 1, sb.label - 1, pixel(sa), pixel(sb)});
       }
   }
   // Carriers come in raster order, so a stable sort by pair keeps each pair's contacts in raster order.
