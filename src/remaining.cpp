@@ -167,6 +167,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   const float grow2 = static_cast<float>(params.grow_distance * params.grow_distance);
   std::vector<int> pixels;
   pixels.reserve(num_remaining);
+  int offset[16];  // of the 16 pixels looked at from a pixel, as index differences
+  for (int k = 0; k < 16; ++k) offset[k] = (k < 8 ? 1 : 2) * (kDy[k % 8] * width + kDx[k % 8]);
   for (int seed_px = next_remaining(state, 0); seed_px < total; seed_px = next_remaining(state, seed_px + 1)) {
     const size_t begin = pixels.size();
     pixels.push_back(seed_px);
@@ -176,13 +178,19 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const int i = pixels[head];
       const int x = i % width, y = i / width;
       x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
+      // Pixels two or more steps inside the image need no border test (most of them).
+      const bool inside = x >= 2 && y >= 2 && x + 2 < width && y + 2 < height;
       for (int k = 0; k < 16; ++k) {
         // The 8 neighbours, then the pixels two steps away across a neighbour without depth.
-        const int step = k < 8 ? 1 : 2, xx = x + step * kDx[k % 8], yy = y + step * kDy[k % 8];
-        if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
-        if (step == 2 && valid_point(pts[(y + kDy[k % 8]) * width + x + kDx[k % 8]])) continue;
-        const int j = yy * width + xx;
+        const int step = k < 8 ? 1 : 2;
+        int j = i + offset[k];
+        if (!inside) {
+          const int xx = x + step * kDx[k % 8], yy = y + step * kDy[k % 8];
+          if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
+          j = yy * width + xx;
+        }
         if (state[static_cast<size_t>(j)] != kRemaining) continue;
+        if (step == 2 && valid_point(pts[i + offset[k - 8]])) continue;
         const cv::Vec3f d = pts[i] - pts[j];
         if (d.dot(d) >= grow2 * static_cast<float>(step * step)) continue;
         state[static_cast<size_t>(j)] = kGrown;
