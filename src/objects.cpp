@@ -290,10 +290,15 @@ cv::Mat objects_only(const cv::Mat& object_labels, const std::vector<Object>& ob
     if (!o.support && !o.background && o.id > 0) new_id[static_cast<size_t>(o.id)] = keep_ids ? o.id : ++next;
   cv::Mat out(object_labels.size(), CV_32S);
   const int last = static_cast<int>(new_id.size()) - 1;
+  // Labels come in long runs (an object's row segments): one lookup and one fill per run.
   for (int y = 0; y < object_labels.rows; ++y) {
     const int* lab = object_labels.ptr<int>(y);
     int* view = out.ptr<int>(y);
-    for (int x = 0; x < object_labels.cols; ++x) view[x] = lab[x] > 0 && lab[x] <= last ? new_id[static_cast<size_t>(lab[x])] : 0;
+    for (int begin = 0; begin < object_labels.cols;) {
+      const int id = lab[begin], end = run_end(lab, begin, object_labels.cols);
+      std::fill(view + begin, view + end, id > 0 && id <= last ? new_id[static_cast<size_t>(id)] : 0);
+      begin = end;
+    }
   }
   return out;
 }
