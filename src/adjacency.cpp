@@ -4,12 +4,12 @@
 // edge pixel, O(edge pixels x r^2) - 40-90 ms at 640x480 (r = 14). Here the patches are propagated
 // into the edge region instead, in two raster passes as in a chamfer distance transform: every
 // non-patch pixel keeps, per patch that reached it, the one seed (a patch pixel) nearest to it in 3D,
-// chosen among the seeds of its already visited 8-neighbours (and the patch pixels touching it). Seeds
+// chosen among the seeds of its already visited neighbours (and the patch pixels touching it). Seeds
 // travel at most r pixels (Euclidean, image) from where they started; a pixel with depth keeps only
 // seeds closer than d_max (the only ones the rule uses), pixels without depth pass on the seeds
 // nearest in the image. Each edge pixel then does what the paper says with its seeds: all patches with
 // a seed become pairwise adjacent, and the pixel joins the patch of the nearest seed.
-// Cost: O(edge pixels x 8 x seeds kept), seeds kept <= kMaxSeeds.
+// Cost: O(edge pixels x 6 x seeds kept), seeds kept <= kMaxSeeds.
 // What changes against the naive scan: a patch is seen only through a chain of non-patch pixels (not
 // across another patch) that keep its seed, and the nearest point is the nearest among the propagated
 // seeds, not among all patch pixels of the disc. tests/test_adjacency.cpp compares with the naive scan.
@@ -142,11 +142,14 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   }
   std::vector<SeedSet> seeds(carriers.size());
 
-  // Two raster passes (forward: from W, NW, N, NE; backward: from E, SE, S, SW), as in a chamfer
-  // distance transform: a seed reaches every pixel within r along a path the passes follow.
+  // Two raster passes (forward: from W, N, NE; backward: from E, S, SW), as in a chamfer distance
+  // transform: a seed reaches every pixel within r along a path the passes follow. NW and SE are left
+  // out: W has already taken what its N holds in the same pass, so a seed at NW arrives through W (and
+  // one at SE through E). A quarter fewer visits; on test63, 165 instead of 114 of 49,481 edge pixels
+  // differ from the naive scan, and the scores on every dev and synthetic set are unchanged.
   const int r2 = r * r;
-  // The pass is a compile-time constant, so the four offsets and their border tests are too.
-  static constexpr int kFrom[2][4][2] = {{{-1, 0}, {-1, -1}, {0, -1}, {1, -1}}, {{1, 0}, {1, 1}, {0, 1}, {-1, 1}}};
+  // The pass is a compile-time constant, so the three offsets and their border tests are too.
+  static constexpr int kFrom[2][3][2] = {{{-1, 0}, {0, -1}, {1, -1}}, {{1, 0}, {0, 1}, {-1, 1}}};
   auto gather = [&](const Carrier& c, auto pass) {
     constexpr auto& from = kFrom[decltype(pass)::value];
     const int x = c.x, y = c.y;
@@ -175,7 +178,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
           if (!own.holds(other.yx[s])) offer(other.yx[s], other.label[s]);
       }
     };
-    // Most carriers are inside the image: their four neighbours need no border test (same order).
+    // Most carriers are inside the image: their neighbours need no border test (same order).
     if (x > 0 && y > 0 && x + 1 < width && y + 1 < height) {
       for (const auto& d : from) visit(c.i + d[1] * width + d[0], x + d[0], y + d[1]);
       return;
