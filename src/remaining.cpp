@@ -227,10 +227,14 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     for (int i : seg_pixels) state[static_cast<size_t>(i)] = kInSegment;
     for (int i : seg_pixels) {
       const int x = i % width, y = i / width;
+      const bool inside = x >= 1 && y >= 1 && x + 1 < width && y + 1 < height;  // no border test needed
       for (int k = 0; k < 8; ++k) {
-        const int xx = x + kDx[k], yy = y + kDy[k];
-        if (xx < 0 || yy < 0 || xx >= width || yy >= height) { touches_border = true; continue; }
-        const int j = yy * width + xx;
+        int j = i + offset[k];
+        if (!inside) {
+          const int xx = x + kDx[k], yy = y + kDy[k];
+          if (xx < 0 || yy < 0 || xx >= width || yy >= height) { touches_border = true; continue; }
+          j = yy * width + xx;
+        }
         if (state[static_cast<size_t>(j)] == kInSegment || (state[static_cast<size_t>(j)] & kInRing)) continue;
         state[static_cast<size_t>(j)] |= kInRing;
         ring.push_back(j);
