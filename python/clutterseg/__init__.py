@@ -53,7 +53,7 @@ from ._clutterseg import (  # noqa: F401  (re-exported)
 sys.modules[__name__ + ".synth"] = synth  # so that `import clutterseg.synth` works too
 
 __all__ = [
-    "Camera", "Segmenter", "Result", "Object", "HiddenObject", "OrientedBox", "Patch", "GraphEdge", "Plane", "Error",
+    "Camera", "Segmenter", "Pipeline", "Result", "Object", "HiddenObject", "OrientedBox", "Patch", "GraphEdge", "Plane", "Error",
     "segment", "default_params", "Frame", "Dataset", "read_depth", "read_labels", "read_color", "write_labels",
     "FrameScores", "SCORE_NAMES", "score_frame", "boundary_tolerance_px", "object_boundaries", "mean_std",
     "FrameRecord", "Evaluation", "evaluate", "summarize", "synth",
@@ -174,6 +174,37 @@ class Segmenter(_core.Segmenter):
 
     def __repr__(self) -> str:
         return "clutterseg.Segmenter(...)"
+
+
+class Pipeline(_core.Pipeline):
+    """Segments the frames of one stream on several cores at once, for throughput: while one frame is
+    segmented the next ones are too, and Results come out in push order, each the same as
+    Segmenter.segment gives for the same stream (docs/PYTHON.md, docs/BENCHMARKS.md "Threads").
+
+    Pipeline(params=None, /, **keywords): parameters as for Segmenter; `threads` is the number of worker
+    threads (0, the default: one per core, and a second frame only while a core is idle).
+
+    push(depth, camera) queues a frame (read in place: do not write to the array until its Result is
+    popped); pop() -> Result of the oldest frame; in_flight, capacity, workers; reset() starts a new
+    stream. map(frames) does it all for an iterable of (depth, camera) pairs. Use one Pipeline from
+    one Python thread.
+    """
+
+    def __init__(self, params: Optional[Mapping[str, Any]] = None, /, **keywords: Any) -> None:
+        super().__init__(_read_params(_params_json(params, keywords)))
+
+    def map(self, frames) -> Iterator[Result]:
+        """Results of (depth, camera) pairs in their order, keeping up to `capacity` frames in flight.
+        A frame without valid depth raises clutterseg.Error when its turn comes."""
+        for depth, camera in frames:
+            if self.in_flight >= self.capacity:
+                yield self.pop()
+            self.push(depth, camera)
+        while self.in_flight:
+            yield self.pop()
+
+    def __repr__(self) -> str:
+        return f"clutterseg.Pipeline(workers={self.workers})"
 
 
 def segment(depth, camera: Camera, params: Optional[Mapping[str, Any]] = None, /, **keywords: Any) -> Result:

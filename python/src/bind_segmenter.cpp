@@ -6,6 +6,8 @@
 
 #include <ctime>
 #include <cstdint>
+#include <deque>
+#include <exception>
 #include <memory>
 #include <mutex>
 #include <opencv2/core.hpp>
@@ -15,6 +17,7 @@
 #include "clutterseg/config.hpp"
 #include "clutterseg/io.hpp"
 #include "clutterseg/objects.hpp"
+#include "clutterseg/pipeline.hpp"
 #include "clutterseg/segmenter.hpp"
 #include "fields.hpp"
 
@@ -89,6 +92,76 @@ class PySegmenter {
 
  private:
   std::unique_ptr<Segmenter> segmenter_;
+  std::mutex mutex_;
+};
+
+// A Pipeline (frames of one stream on several cores, Results in order): push keeps the depth array
+// alive until its Result is popped, because the core reads it in place. Meant for one Python thread (a
+// stream has one order); the GIL is released while it waits (push when `capacity` frames are in
+// flight, pop until the oldest is done), so other Python threads run meanwhile.
+class PyPipeline {
+ public:
+  explicit PyPipeline(const std::string& params_json) {
+    try {
+      params_ = params_from_json(params_json, "clutterseg.Pipeline params");
+      pipeline_ = std::make_unique<Pipeline>(params_);
+    } catch (const Error& e) {
+      throw py::value_error(e.what());
+    }
+  }
+
+  void push(const py::object& depth_array, Camera camera) {
+    const cv::Mat depth = view_2d(depth_array, {CV_16U, CV_32F}, "depth");
+    if (camera.width == 0 && camera.height == 0) {
+      camera.width = depth.cols;
+      camera.height = depth.rows;
+    }
+    try {
+      check_camera(camera, depth.cols, depth.rows, "camera");
+    } catch (const Error& e) {
+      throw py::value_error(e.what());
+    }
+    {
+      py::gil_scoped_release release;
+      const std::lock_guard<std::mutex> lock(mutex_);
+      pipeline_->push(depth, camera);
+    }
+    arrays_.push_back({depth_array, reinterpret_cast<std::uintptr_t>(depth.data)});
+  }
+
+  std::shared_ptr<PyResult> pop() {
+    if (arrays_.empty()) throw py::value_error("clutterseg.Pipeline.pop: no frame in flight (push one first)");
+    auto out = std::make_shared<PyResult>();
+    out->input_address = arrays_.front().second;
+    std::exception_ptr error;
+    {
+      py::gil_scoped_release release;
+      const std::lock_guard<std::mutex> lock(mutex_);
+      try {
+        out->r = pipeline_->pop();
+      } catch (...) {
+        error = std::current_exception();
+      }
+    }
+    arrays_.pop_front();  // the frame is done with, whatever it threw
+    if (error) std::rethrow_exception(error);
+    out->tracked = params_.tracking.enabled;
+    return out;
+  }
+
+  void reset() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    pipeline_->reset();
+  }
+
+  int in_flight() const { return static_cast<int>(arrays_.size()); }
+  int capacity() const { return pipeline_->capacity(); }
+  int workers() const { return pipeline_->workers(); }
+
+ private:
+  std::unique_ptr<Pipeline> pipeline_;
+  Params params_;
+  std::deque<std::pair<py::object, std::uintptr_t>> arrays_;  // pushed, not yet popped; touched with the GIL held
   std::mutex mutex_;
 };
 
@@ -377,6 +450,26 @@ void bind_segmenter(py::module_& m) {
       .def("reset", &PySegmenter::reset, py::call_guard<py::gil_scoped_release>(),  // may wait for a frame
            "Forgets the temporal window: the next frame starts a new stream.")
       .def_property_readonly("_params_json", &PySegmenter::params_json, "parameters as JSON text");
+
+  py::class_<PyPipeline>(m, "Pipeline", "The C++ Pipeline; use clutterseg.Pipeline, which takes dicts and keywords.")
+      .def(py::init<const std::string&>(), py::arg("params_json"),
+           "params_json: parameters as JSON text (the form of `clutterseg --dump-config`)")
+      .def("push", &PyPipeline::push, py::arg("depth"), py::arg("camera"),
+           "push(depth, camera)\n\n"
+           "Queues the next frame of the stream (arguments as Segmenter.segment). The array is read in place\n"
+           "and kept alive until its Result is popped: do not write to it before. Blocks (GIL released)\n"
+           "while `capacity` frames are in flight; raises as Segmenter.segment for a bad array or camera.")
+      .def("pop", &PyPipeline::pop,
+           "pop() -> Result\n\n"
+           "The oldest pushed frame's Result, the same as Segmenter.segment gives for the same stream; waits\n"
+           "for it (GIL released). Raises clutterseg.Error for that frame instead if it had no valid depth\n"
+           "(the stream goes on without it), ValueError if nothing is in flight.")
+      .def("reset", &PyPipeline::reset, py::call_guard<py::gil_scoped_release>(),
+           "Forgets the temporal window and the object tracks once the frames in flight are through:\n"
+           "the next pushed frame starts a new stream.")
+      .def_property_readonly("in_flight", &PyPipeline::in_flight, "frames pushed and not yet popped")
+      .def_property_readonly("capacity", &PyPipeline::capacity, "frames that may be in flight before push waits")
+      .def_property_readonly("workers", &PyPipeline::workers, "worker threads (params threads; 0 = one per core)");
 }
 
 }  // namespace clutterseg::python
