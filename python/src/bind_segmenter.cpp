@@ -110,6 +110,12 @@ class PyPipeline {
     }
   }
 
+  // The frames in flight are finished before their arrays are let go (the workers read them).
+  ~PyPipeline() {
+    py::gil_scoped_release release;
+    pipeline_.reset();
+  }
+
   void push(const py::object& depth_array, Camera camera) {
     const cv::Mat depth = view_2d(depth_array, {CV_16U, CV_32F}, "depth");
     if (camera.width == 0 && camera.height == 0) {

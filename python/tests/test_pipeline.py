@@ -92,3 +92,16 @@ def test_map_yields_every_frame_in_order_and_pop_without_a_frame_is_an_error(str
         pipeline.pop()
     with pytest.raises(ValueError, match="threads"):
         clutterseg.Pipeline(threads=-5)
+
+
+def test_a_pipeline_dropped_with_frames_in_flight_finishes_them_first(stream):
+    # The workers read the arrays in place: the Pipeline must not let them go before the frames are done.
+    for _ in range(3):
+        pipeline = clutterseg.Pipeline(threads=2)
+        for f in stream[:4]:
+            pipeline.push(f.depth.copy(), f.camera)
+        del pipeline
+        gc.collect()
+    pipeline = clutterseg.Pipeline(threads=2)
+    pipeline.push(stream[0].depth, stream[0].camera)
+    assert pipeline.pop().object_labels.shape == stream[0].depth.shape
