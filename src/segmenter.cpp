@@ -117,6 +117,7 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   }
   if (table)
     for (Patch& patch : r.patches) patch.table = lies_in(patch, r.points, *table, p.support);
+  if (table) unmark_curved_table(r.patches, p.support);                          // a bowl's floor is no table
   watch.mark("support");
   const int num_patches = static_cast<int>(r.patches.size());
   Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency

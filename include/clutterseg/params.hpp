@@ -124,6 +124,9 @@ struct Params {
     double contact_distance = 0.05;  // a patch rests on a plane when its lowest point is this close [m]
     double region_margin = 0.05; // an object stands on the table when it projects within this of the
                                  // table's visible region (convex hull in the plane) [m]
+    double curved_bins_ratio = 2; // a patch whose normal histogram occupies more than this times the bins
+                                  // of the largest table patch is curved, never table (a bowl's floor;
+                                  // unmark_curved_table, beyond the paper); 0 = off
     double wall_min_extent = 0.35; // a flat object roughly perpendicular to the table (> 60 deg) whose
                                    // largest face is at least this long along the table is a wall [m]
   } support;
