@@ -4,12 +4,18 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace clutterseg {
 namespace {
 
-// A pixel that can take a label: no measurement and no label yet.
-inline bool hole(float d, int label) { return !(d > 0) && label == 0; }
+inline std::uint64_t word_at(const uchar* p) {
+  std::uint64_t w;
+  std::memcpy(&w, p, 8);
+  return w;
+}
 
 }  // namespace
 
@@ -20,81 +26,83 @@ int fill_depth_holes(cv::Mat& object_labels, const cv::Mat& depth, std::vector<O
   std::vector<uchar> takes(static_cast<size_t>(m) + 1, 0);  // objects that may take pixels
   for (int k = 1; k <= m; ++k) takes[static_cast<size_t>(k)] = !objects[static_cast<size_t>(k - 1)].support &&
                                                               !objects[static_cast<size_t>(k - 1)].background;
-  // Holes in a byte mask (the scans below skip eight measured pixels at a time).
+  const auto candidate = [&](int a, int b) { return a > 0 && a == b && a <= m && takes[static_cast<size_t>(a)] ? a : 0; };
+  // Holes (no measurement, NaN included, and no label) in a byte mask, 255 = hole, in a vector loop; the
+  // scans below skip eight pixels at a time.
   cv::Mat mask(rows, cols, CV_8U);
-  int holes = 0;
   for (int y = 0; y < rows; ++y) {
     const float* d = depth.ptr<float>(y);
-    const int* l = object_labels.ptr<int>(y);
+    const int* lab = object_labels.ptr<int>(y);
     uchar* h = mask.ptr<uchar>(y);
-    for (int x = 0; x < cols; ++x) h[x] = hole(d[x], l[x]);
+    int x = 0;
+#if defined(__SSE2__)
+    // 16 pixels at a time (the compiler leaves this loop scalar): measured or labelled -> 0, else 255.
+    const __m128 zero = _mm_setzero_ps();
+    const __m128i izero = _mm_setzero_si128();
+    for (; x + 16 <= cols; x += 16) {
+      __m128i keep[4];
+      for (int q = 0; q < 4; ++q) {
+        const __m128i measured = _mm_castps_si128(_mm_cmpgt_ps(_mm_loadu_ps(d + x + 4 * q), zero));
+        const __m128i unlabelled = _mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(lab + x + 4 * q)), izero);
+        keep[q] = _mm_andnot_si128(measured, unlabelled);  // -1 = hole
+      }
+      const __m128i bytes = _mm_packs_epi16(_mm_packs_epi32(keep[0], keep[1]), _mm_packs_epi32(keep[2], keep[3]));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(h + x), bytes);
+    }
+#endif
+    for (; x < cols; ++x) h[x] = (d[x] > 0.f) | (lab[x] != 0) ? 0 : 255;
   }
-  // The label each hole gets: along its row first, then along its column; conflicts stay 0. Read from
-  // the labels before any fill, so the result does not depend on the order of the scans.
-  cv::Mat fill(rows, cols, CV_32S, cv::Scalar(0));
-  std::vector<uchar> row_filled(static_cast<size_t>(rows), 0);  // the last pass skips the other rows
-  const auto candidate = [&](int a, int b) { return a > 0 && a == b && a <= m && takes[static_cast<size_t>(a)] ? a : 0; };
+  constexpr std::uint64_t kAllHoles = ~std::uint64_t{0};
+  int filled = 0;
+  // Rows. The fills go straight into the labels: they only touch holes, and both scans read the labels of
+  // non-holes only, so the column scan below decides as if it ran first.
   for (int y = 0; y < rows; ++y) {
     const uchar* h = mask.ptr<uchar>(y);
-    const int* l = object_labels.ptr<int>(y);
-    int* f = fill.ptr<int>(y);
+    int* l = object_labels.ptr<int>(y);
     int x = 0;
     while (x < cols) {
-      if (x + 8 <= cols) {
-        std::uint64_t word;
-        std::memcpy(&word, h + x, 8);
-        if (word == 0) { x += 8; continue; }
-      }
+      if (x + 8 <= cols && word_at(h + x) == 0) { x += 8; continue; }
       if (!h[x]) { ++x; continue; }
       const int begin = x;
+      while (x + 8 <= cols && word_at(h + x) == kAllHoles) x += 8;
       while (x < cols && h[x]) ++x;
-      if (begin > 0 && x < cols && x - begin <= max_run) {
-        const int k = candidate(l[begin - 1], l[x]);
-        if (k) {
-          std::fill(f + begin, f + x, k);
-          row_filled[static_cast<size_t>(y)] = 1;
+      if (begin == 0 || x == cols || x - begin > max_run) continue;
+      const int k = candidate(l[begin - 1], l[x]);
+      if (!k) continue;
+      std::fill(l + begin, l + x, k);
+      filled += x - begin;
+      objects[static_cast<size_t>(k - 1)].pixel_count += x - begin;
+    }
+  }
+  // Columns: a run starts at a hole below a non-hole; walk down at most max_run + 1 pixels. A pixel the
+  // row scan gave to another object is claimed by two: nobody's.
+  for (int y = 1; y < rows; ++y) {
+    const uchar* h = mask.ptr<uchar>(y);
+    const uchar* above = mask.ptr<uchar>(y - 1);
+    for (int x = 0; x < cols; ++x) {
+      if (x + 8 <= cols && (word_at(h + x) & ~word_at(above + x)) == 0) { x += 7; continue; }
+      if (!h[x] || above[x]) continue;
+      int end = y;
+      while (end < rows && end - y <= max_run && mask.ptr<uchar>(end)[x]) ++end;
+      if (end == rows || end - y > max_run) continue;
+      const int k = candidate(object_labels.ptr<int>(y - 1)[x], object_labels.ptr<int>(end)[x]);
+      if (!k) continue;
+      for (int yy = y; yy < end; ++yy) {
+        int& l = object_labels.ptr<int>(yy)[x];
+        if (l == k) continue;
+        if (l == 0) {
+          l = k;
+          ++filled;
+          ++objects[static_cast<size_t>(k - 1)].pixel_count;
+        } else {  // the row scan gave it to another object
+          --objects[static_cast<size_t>(l - 1)].pixel_count;
+          --filled;
+          l = 0;
         }
       }
     }
   }
-  // Columns: a run starts at a hole whose upper neighbour is none; walk down at most max_run + 1 pixels.
-  for (int y = 1; y < rows; ++y) {
-    const uchar* h = mask.ptr<uchar>(y);
-    const uchar* above = mask.ptr<uchar>(y - 1);
-    int x = 0;
-    while (x < cols) {
-      if (x + 8 <= cols) {
-        std::uint64_t word;
-        std::memcpy(&word, h + x, 8);
-        if (word == 0) { x += 8; continue; }
-      }
-      if (!h[x] || above[x]) { ++x; continue; }
-      int end = y;
-      while (end < rows && end - y <= max_run && mask.at<uchar>(end, x)) ++end;
-      if (end < rows && end - y <= max_run) {
-        const int k = candidate(object_labels.at<int>(y - 1, x), object_labels.at<int>(end, x));
-        if (k)
-          for (int yy = y; yy < end; ++yy) {
-            int& f = fill.at<int>(yy, x);
-            f = f == 0 || f == k ? k : -1;  // two objects claim it: nobody's
-            row_filled[static_cast<size_t>(yy)] = 1;
-          }
-      }
-      ++x;
-    }
-  }
-  for (int y = 0; y < rows; ++y) {
-    if (!row_filled[static_cast<size_t>(y)]) continue;
-    const int* f = fill.ptr<int>(y);
-    int* l = object_labels.ptr<int>(y);
-    for (int x = 0; x < cols; ++x)
-      if (f[x] > 0) {
-        l[x] = f[x];
-        ++objects[static_cast<size_t>(f[x] - 1)].pixel_count;
-        ++holes;
-      }
-  }
-  return holes;
+  return filled;
 }
 
 }  // namespace clutterseg
