@@ -106,7 +106,7 @@ struct Params {
   struct Remaining {
     double grow_distance = 0.01; // 8-connected Euclidean region growing [m]
     int tiny_px = 20;            // "very few points" at 320x240 [px], scaled (PixelScale)
-    int hole_px = 6;             // beyond the paper: a run of pixels without depth at most this long
+    int hole_px = 4;             // beyond the paper: a run of pixels without depth at most this long
                                  // with one object on both ends (row or column) is that object's
                                  // (holes.hpp); at 320x240 [px], scaled; 0 = pixels without depth stay 0
   } remaining;
