@@ -498,15 +498,12 @@ int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv:
   const auto* pts = points.ptr<cv::Vec3f>();
   cv::Mat off(patch_labels.size(), CV_8U, cv::Scalar(0));  // pixels of flat patches off their dominant plane
   uchar* mark = off.ptr<uchar>();
-  // Patches near the table are tried too: cut_off_table cuts what stands more than the table's tolerance
-  // above the table, a flat object's lowest part (8-15 mm above it) only a plane fitted to the patch finds
-  // (osd test42: the rim of the upturned cup). The table and support parameters are kept for callers.
-  (void)table;
-  (void)support;
+  const std::vector<int> near_table = table ? patches_near(patches, points, *table, support) : std::vector<int>{};
   int cut = 0;
   for (size_t p = 0; p < patches.size(); ++p) {
     const Patch& patch = patches[p];
     if (patch.curved || static_cast<int>(patch.pixels.size()) < 2 * min_px) continue;  // a plane to split at
+    if (std::binary_search(near_table.begin(), near_table.end(), static_cast<int>(p))) continue;  // cut_off_table's
     Plane plane;
     if (dominant_plane(patch.pixels, points, band, plane) < 0.6) continue;
     const std::vector<int> outside = off_plane(patch.pixels, pts, plane, band);

@@ -83,9 +83,8 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
 // joined through a gap in the edges) is split at its dominant plane (RANSAC, plane_tolerance(band, z)):
 // when at least min_px of its pixels lie off that plane, the edge pixels between the two parts are
 // marked in `edges`, as for cut_off_table. Curved patches (Patch::curved: a half-cylinder is half a plane
-// too) and patches with less than 60 % of their points on a plane are left alone; patches near the table's
-// plane are tried too (since 2026-12-02: parts 8-15 mm above the table, below cut_off_table's tolerance).
-// `table` and `support` are no longer read. Returns the number of pixels cut off.
+// too), patches with less than 60 % of their points on a plane and patches near the table's plane (which
+// cut_off_table splits at that plane) are left alone. Returns the number of pixels cut off.
 int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                     double band, int min_px, const std::optional<Plane>& table, const Params::Support& support);
 
