@@ -74,6 +74,7 @@ void validate(const Params& p) {
   in_range("graph.theta_c", p.graph.theta_c, 0, 1000);
   in_range("remaining.grow_distance", p.remaining.grow_distance, 0, 1);
   int_range("remaining.tiny_px", p.remaining.tiny_px, 0, 100000);
+  int_range("remaining.hole_px", p.remaining.hole_px, 0, 1000);
   above("support.plane_band", p.support.plane_band, 0, 1);
   in_range("support.pixel_band", p.support.pixel_band, 0, 1);
   in_range("support.table_angle_deg", p.support.table_angle_deg, 0, 90);
@@ -81,6 +82,7 @@ void validate(const Params& p) {
   in_range("support.contact_distance", p.support.contact_distance, 0, 10);
   in_range("support.region_margin", p.support.region_margin, 0, 10);
   in_range("support.wall_min_extent", p.support.wall_min_extent, 0, 100);
+  in_range("support.curved_bins_ratio", p.support.curved_bins_ratio, 0, 1000);
   int_range("tracking.max_missed", p.tracking.max_missed, 0, 100000);
   above("tracking.max_step", p.tracking.max_step, 0, 100);
   in_range("tracking.merge_share", p.tracking.merge_share, 0, 1);

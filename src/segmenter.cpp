@@ -11,6 +11,7 @@
 #include "clutterseg/normals.hpp"
 #include "clutterseg/objects.hpp"
 #include "clutterseg/parallel.hpp"
+#include "clutterseg/holes.hpp"
 #include "clutterseg/remaining.hpp"
 #include "clutterseg/stopwatch.hpp"
 #include "clutterseg/support.hpp"
@@ -116,6 +117,7 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   }
   if (table)
     for (Patch& patch : r.patches) patch.table = lies_in(patch, r.points, *table, p.support);
+  if (table) unmark_curved_table(r.patches, p.support);                          // a bowl's floor is no table
   watch.mark("support");
   const int num_patches = static_cast<int>(r.patches.size());
   Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency
@@ -157,6 +159,8 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   if (table)                                                                     // table, walls
     classify_objects(r.objects, r.patches, r.object_labels, r.points, support_of(*table, r.patches, r.points, p.support),
                      p.support);
+  if (p.remaining.hole_px > 0)                                                   // pixels without depth
+    fill_depth_holes(r.object_labels, r.depth, r.objects, px.length(p.remaining.hole_px));  // (beyond the paper)
   watch.mark("objects");
   if (p.tracking.enabled && !r.object_labels.empty()) {                          // stable ids (beyond the paper)
     if (p.smoothing.temporal ? temporal_.restarted() : tracked_depth_.empty() || scene_changed(tracked_depth_, depth, p.smoothing))

@@ -403,6 +403,22 @@ bool lies_in(const Patch& patch, const cv::Mat& points, const Plane& plane, cons
   return patch.mean_normal.dot(plane.normal) >= min_cos && mostly_within(patch.pixels, points, plane, 0.5 * params.plane_band, 0.8);
 }
 
+int unmark_curved_table(std::vector<Patch>& patches, const Params::Support& params) {
+  if (params.curved_bins_ratio <= 0) return 0;
+  const Patch* largest = nullptr;
+  for (const Patch& patch : patches)
+    if (patch.table && (!largest || patch.pixels.size() > largest->pixels.size())) largest = &patch;
+  if (!largest) return 0;
+  const double limit = params.curved_bins_ratio * largest->occupied_bins;
+  int unmarked = 0;
+  for (Patch& patch : patches)
+    if (patch.table && patch.occupied_bins > limit) {
+      patch.table = false;
+      ++unmarked;
+    }
+  return unmarked;
+}
+
 namespace {
 
 // Where a marked pixel meets an unmarked pixel of its patch, both become edge pixels: the two parts are

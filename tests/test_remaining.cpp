@@ -1,6 +1,7 @@
 // Paper j): the five rules for remaining pixels, each on a built case.
 #include <gtest/gtest.h>
 
+#include "clutterseg/holes.hpp"
 #include "clutterseg/normals.hpp"
 #include "clutterseg/remaining.hpp"
 #include "scene_patches.hpp"
@@ -164,4 +165,35 @@ TEST(Remaining, ASegmentGrowsAcrossSinglePixelsWithoutDepth) {
   const cv::Mat o = c.run({0}, 1, 40);  // each speck alone would be tiny (< 40 px): noise
   EXPECT_EQ(o.at<int>(10, 25), 2);      // one segment of 126 px: a new object
   EXPECT_EQ(o.at<int>(6, 30), 2);
+}
+
+// Beyond the paper (holes.hpp): a pixel without depth takes the object that encloses it along a row or a
+// column, never the table's, never across two objects, and never beyond max_run.
+TEST(Remaining, HolesEnclosedByOneObjectJoinIt) {
+  cv::Mat labels(20, 40, CV_32S, cv::Scalar(3));  // 3: the table
+  cv::Mat depth(20, 40, CV_32F, cv::Scalar(1.f));
+  labels(cv::Rect(5, 5, 10, 10)).setTo(1);        // object 1
+  labels(cv::Rect(18, 5, 10, 10)).setTo(2);       // object 2
+  depth(cv::Rect(8, 8, 3, 3)).setTo(0.f);         // speckle inside object 1
+  labels(cv::Rect(8, 8, 3, 3)).setTo(0);
+  depth(cv::Rect(15, 5, 3, 10)).setTo(0.f);       // a shadow between objects 1 and 2
+  labels(cv::Rect(15, 5, 3, 10)).setTo(0);
+  depth(cv::Rect(28, 5, 3, 10)).setTo(0.f);       // a shadow between object 2 and the table
+  labels(cv::Rect(28, 5, 3, 10)).setTo(0);
+  depth(cv::Rect(34, 8, 2, 3)).setTo(0.f);        // a hole in the table
+  labels(cv::Rect(34, 8, 2, 3)).setTo(0);
+  std::vector<Object> objects(3);
+  for (int k = 0; k < 3; ++k) objects[static_cast<size_t>(k)].id = k + 1;
+  objects[0].pixel_count = 91;
+  objects[2].support = true;
+  cv::Mat too_short = labels.clone();
+  std::vector<Object> copy = objects;
+  EXPECT_EQ(fill_depth_holes(too_short, depth, copy, 2), 0);  // runs of 3 and more stay holes
+  EXPECT_EQ(fill_depth_holes(labels, depth, objects, 3), 9);
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(8, 8, 3, 3)) == 1), 9);
+  EXPECT_EQ(objects[0].pixel_count, 100);
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(15, 5, 3, 10))), 0);   // between two objects
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(28, 5, 3, 10))), 0);   // between an object and the table
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(34, 8, 2, 3))), 0);    // in the table
+  EXPECT_EQ(fill_depth_holes(labels, depth, objects, 0), 0);         // 0: off
 }

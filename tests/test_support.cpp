@@ -98,3 +98,24 @@ TEST(Support, EdgePixelsGivenToTheTableAboveItAreReleased) {
     ASSERT_LE(plane.distance({q[0], q[1], q[2]}), plane_tolerance(Params{}.support.pixel_band, q[2]) + 1e-6f) << "pixel " << i;
   }
 }
+
+// Beyond the paper: a patch lying in the table's band whose normals spread far more than the table's (a
+// bowl's floor) is not table; the small flat table pieces between objects stay table.
+TEST(Support, ACurvedPatchInTheBandIsNoTable) {
+  std::vector<Patch> patches(4);
+  const int bins[4] = {10, 6, 21, 40}, size[4] = {5000, 300, 800, 900};
+  for (int k = 0; k < 4; ++k) {
+    patches[static_cast<size_t>(k)].occupied_bins = bins[k];
+    patches[static_cast<size_t>(k)].pixels.resize(static_cast<size_t>(size[k]));
+    patches[static_cast<size_t>(k)].table = k != 3;  // patch 3: an object, left alone
+  }
+  Params::Support params;
+  params.curved_bins_ratio = 0;
+  EXPECT_EQ(unmark_curved_table(patches, params), 0);
+  params = Params::Support{};  // default 2: more than 20 bins, twice the largest table patch's 10
+  EXPECT_EQ(unmark_curved_table(patches, params), 1);
+  EXPECT_TRUE(patches[0].table);
+  EXPECT_TRUE(patches[1].table);
+  EXPECT_FALSE(patches[2].table);
+  EXPECT_FALSE(patches[3].table);
+}

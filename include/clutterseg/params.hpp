@@ -106,6 +106,9 @@ struct Params {
   struct Remaining {
     double grow_distance = 0.01; // 8-connected Euclidean region growing [m]
     int tiny_px = 20;            // "very few points" at 320x240 [px], scaled (PixelScale)
+    int hole_px = 4;             // beyond the paper: a run of pixels without depth at most this long
+                                 // with one object on both ends (row or column) is that object's
+                                 // (holes.hpp); at 320x240 [px], scaled; 0 = pixels without depth stay 0
   } remaining;
 
   // Beyond the paper: the support plane (table), decided per patch before the graph (support.hpp).
@@ -121,6 +124,9 @@ struct Params {
     double contact_distance = 0.05;  // a patch rests on a plane when its lowest point is this close [m]
     double region_margin = 0.05; // an object stands on the table when it projects within this of the
                                  // table's visible region (convex hull in the plane) [m]
+    double curved_bins_ratio = 2; // a patch whose normal histogram occupies more than this times the bins
+                                  // of the largest table patch is curved, never table (a bowl's floor;
+                                  // unmark_curved_table, beyond the paper); 0 = off
     double wall_min_extent = 0.35; // a flat object roughly perpendicular to the table (> 60 deg) whose
                                    // largest face is at least this long along the table is a wall [m]
   } support;

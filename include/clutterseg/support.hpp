@@ -65,6 +65,12 @@ Eigen::Vector3f up_in_camera(const Camera& camera);
 // its points within half the plane tolerance.
 bool lies_in(const Patch& patch, const cv::Mat& points, const Plane& plane, const Params::Support& params);
 
+// Beyond the paper: a patch marked table whose normals fill more than params.curved_bins_ratio times the
+// histogram bins (Patch::occupied_bins) of the largest table patch is curved, not table: the floor of a
+// bowl or a plate lies within the table's band but its normals spread far more than the table's noise.
+// Unmarks such patches; returns how many. A ratio of 0 unmarks nothing.
+int unmark_curved_table(std::vector<Patch>& patches, const Params::Support& params);
+
 // Patches that are mostly table but hold core pixels standing clear of the plane (more than the plane
 // tolerance above it): objects the edges did not close off (a gap in the edge band, a smooth foot). Marks
 // in `edges` (CV_8U, 255 = edge) the pixels where such a part meets the table part of its patch, so that
