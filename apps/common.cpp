@@ -55,7 +55,7 @@ void ParamOptions::add_to(CLI::App& cmd) {
   cmd.add_option("--theta-c", theta_c, "graph-cut threshold Theta_c (paper default 0.5)");
   cmd.add_option("--theta-h", theta_h, "curvature-similarity threshold Theta_h (paper default 0.5)");
   cmd.add_option("--seed", seed, "seed for every random choice");
-  cmd.add_option("--threads", threads, "threads (0 = all cores)");
+  cmd.add_option("--threads", threads, "row threads per frame (0 = the idle cores but one; serial on 2 cores)");
   cmd.add_flag("--no-temporal", no_temporal, "treat frames independently (no temporal smoothing)");
   cmd.add_flag("--objects-only", objects_only, "label 0 for the table and background surfaces");
   cmd.add_flag("--no-tracking", no_tracking, "number objects 1..M afresh every frame (no stable ids across frames)");

@@ -196,7 +196,10 @@ void set_threads(int threads) {
 int region_threads() {
   if (t_threads == 1 || cores() == 1) return 1;
   if (t_threads > 1) return std::min(t_threads, cores());
-  return cached_free_cores();
+  // The default leaves one idle core alone: rows over the 2 cores of our test host never paid (0.95-1.05x
+  // one thread, docs/BENCHMARKS.md "Threads"), while another frame (Pipeline), the sensor driver or the
+  // robot's own work gains a whole core. With 3 or more idle cores the rows spread over all but one.
+  return std::max(1, cached_free_cores() - 1);
 }
 
 void parallel_for_rows(int rows, const std::function<void(int, int)>& body) {

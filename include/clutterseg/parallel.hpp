@@ -26,7 +26,7 @@ namespace clutterseg {
 void parallel_for_rows(int rows, const std::function<void(int begin, int end)>& body);
 
 // Sets the calling thread's thread count for parallel_for_rows: 1 = serial, N = up to N threads,
-// 0 (the default) = as many as there are idle cores at each region (one when the machine is busy).
+// 0 (the default) = the idle cores at each region but one (serial on a 2-core or a busy machine).
 void set_threads(int threads);
 
 // The threads the calling thread's next region would use (1 when it runs serially).

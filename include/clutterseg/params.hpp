@@ -146,7 +146,8 @@ struct Params {
   } tracking;
 
   std::uint64_t seed = 1;        // every random choice is seeded from this
-  int threads = 0;               // 0 = all cores (OpenMP); results do not depend on it
+  int threads = 0;               // rows of a frame: 0 = the idle cores but one (serial on 2 cores), N = N;
+                                 // Pipeline workers: 0 = one per core; results do not depend on it
   bool keep_freed_memory = true; // tune glibc malloc to reuse a frame's memory (keep_freed_memory())
 };
 

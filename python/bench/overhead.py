@@ -27,7 +27,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--data", default=here.parents[2] / "shared" / "data" / "dev", type=Path)
     parser.add_argument("--repeats", type=int, default=20, help="passes over every set (a stream each)")
-    parser.add_argument("--threads", type=int, default=0, help="Params::threads (0 = all cores)")
+    parser.add_argument("--threads", type=int, default=0, help="Params::threads (0 = the idle cores but one)")
     args = parser.parse_args()
 
     frames = {name: list(clutterseg.Dataset(args.data / name)) for name in DEV_SETS}
