@@ -188,8 +188,11 @@ class Pool {
 
 void set_threads(int threads) {
   // OpenCV's calls here (median, Gaussian, components) are short; its pool's idle threads spin and
-  // took the cores our rows needed (2 threads ran 4x slower than 1), so OpenCV stays serial.
-  cv::setNumThreads(1);
+  // took the cores our rows needed (2 threads ran 4x slower than 1), so OpenCV stays serial. Set once:
+  // cv::setNumThreads is a process-wide setting and not safe to call from threads at once (TSan: a race
+  // inside TBB when three Segmenters started together).
+  static std::once_flag opencv_serial;
+  std::call_once(opencv_serial, [] { cv::setNumThreads(1); });
   t_threads = std::max(0, threads);
 }
 
