@@ -44,6 +44,22 @@ double clock_seconds(clockid_t clock) {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
+// The caller's depth array as a cv::Mat view (no copy), and `camera` checked against it; a camera made
+// without a size (Camera(fx, fy, cx, cy)) takes the image's. ValueError for a camera that does not fit.
+cv::Mat depth_view(const py::object& depth_array, Camera& camera) {
+  const cv::Mat depth = view_2d(depth_array, {CV_16U, CV_32F}, "depth");
+  if (camera.width == 0 && camera.height == 0) {
+    camera.width = depth.cols;
+    camera.height = depth.rows;
+  }
+  try {
+    check_camera(camera, depth.cols, depth.rows, "camera");
+  } catch (const Error& e) {
+    throw py::value_error(e.what());
+  }
+  return depth;
+}
+
 // A Segmenter shared by Python threads: calls on one instance take turns (the temporal window is one
 // stream); different instances run in parallel, the GIL released.
 class PySegmenter {
@@ -58,16 +74,7 @@ class PySegmenter {
   }
 
   std::shared_ptr<PyResult> segment(const py::object& depth_array, Camera camera) {
-    const cv::Mat depth = view_2d(depth_array, {CV_16U, CV_32F}, "depth");
-    if (camera.width == 0 && camera.height == 0) {  // Camera(fx, fy, cx, cy): the size is the image's
-      camera.width = depth.cols;
-      camera.height = depth.rows;
-    }
-    try {
-      check_camera(camera, depth.cols, depth.rows, "camera");
-    } catch (const Error& e) {
-      throw py::value_error(e.what());
-    }
+    const cv::Mat depth = depth_view(depth_array, camera);
     auto out = std::make_shared<PyResult>();
     out->input_address = reinterpret_cast<std::uintptr_t>(depth.data);
     {
@@ -117,16 +124,7 @@ class PyPipeline {
   }
 
   void push(const py::object& depth_array, Camera camera) {
-    const cv::Mat depth = view_2d(depth_array, {CV_16U, CV_32F}, "depth");
-    if (camera.width == 0 && camera.height == 0) {
-      camera.width = depth.cols;
-      camera.height = depth.rows;
-    }
-    try {
-      check_camera(camera, depth.cols, depth.rows, "camera");
-    } catch (const Error& e) {
-      throw py::value_error(e.what());
-    }
+    const cv::Mat depth = depth_view(depth_array, camera);
     {
       py::gil_scoped_release release;
       const std::lock_guard<std::mutex> lock(mutex_);
