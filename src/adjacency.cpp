@@ -21,6 +21,7 @@
 #include <opencv2/imgproc.hpp>
 #include <type_traits>
 
+#include "clutterseg/limits.hpp"
 #include "clutterseg/parallel.hpp"
 
 namespace clutterseg {
@@ -43,6 +44,7 @@ std::uint32_t pack(int x, int y) { return static_cast<std::uint32_t>(y) << 16 | 
 
 // The yx of an empty slot: no pixel of a frame has it (frames are at most kMaxFrameSide wide).
 constexpr std::uint32_t kNoSeed = 0xffffffffu;
+static_assert(kMaxFrameSide <= 0xffff, "pack() keeps x and y in 16 bits each, below kNoSeed");
 
 // The seeds a pixel holds, stored as arrays (52 bytes; the sets of all carriers of a 640x480 frame take
 // about 2 MB). Most of the work is asking whether a seed is held already: four compares without a
