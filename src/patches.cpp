@@ -131,8 +131,12 @@ int label_runs(const cv::Mat& edges, std::vector<Run>& runs) {
 
 }  // namespace
 
-Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
-                        const NormalPlanes& normals, const Params::Patches& params, int min_size) {
+namespace {
+
+// extract_patches, and update_patches when `previous` is given: a component with exactly the pixels of
+// a previous patch takes that patch (moved), so only new components are measured.
+Patches build_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera, const NormalPlanes& normals,
+                      const Params::Patches& params, int min_size, Patches* previous) {
   const auto fits = [&](const cv::Mat& m, int type) { return m.type() == type && m.size() == edges.size(); };
   const bool planes_fit = std::all_of(normals.begin(), normals.end(), [&](const cv::Mat& n) { return fits(n, CV_32F); });
   if (!fits(edges, CV_8U) || !fits(depth, CV_32F) || !planes_fit)
@@ -151,8 +155,28 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
     s.y0 = std::min(s.y0, run.y);
     s.y1 = run.y;
   }
-  for (ComponentSums& s : sums)
-    if (s.area >= min_size) {
+  // The previous patch each component is (0: a new component). Edges were only added, so a component
+  // lies within one previous component; with its first pixel's previous label and that patch's size, it
+  // is the whole patch.
+  std::vector<int> same_as(static_cast<size_t>(count), 0);
+  if (previous) {
+    const int* old_label = previous->labels.ptr<int>();
+    int next = 1;  // components are numbered in the raster order of their first run
+    for (const Run& run : runs) {
+      if (run.component != next) continue;  // not the component's first run
+      ++next;
+      const int old = old_label[run.y * cols + run.x0];
+      ComponentSums& s = sums[static_cast<size_t>(run.component)];
+      if (old > 0 && static_cast<size_t>(s.area) == previous->patches[static_cast<size_t>(old - 1)].pixels.size())
+        same_as[static_cast<size_t>(run.component)] = old;
+    }
+  }
+  const auto measured = [&](int component) {
+    return sums[static_cast<size_t>(component)].area >= min_size && same_as[static_cast<size_t>(component)] == 0;
+  };
+  for (int c = 1; c < count; ++c)
+    if (measured(c)) {
+      ComponentSums& s = sums[static_cast<size_t>(c)];
       s.pixels.reserve(static_cast<size_t>(s.area));
       s.histogram.assign(static_cast<size_t>(kCounters * bins * bins), 0);
     }
@@ -161,8 +185,8 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
   std::vector<float> row_rays(static_cast<size_t>(edges.rows));
   for (int y = 0; y < edges.rows; ++y) row_rays[static_cast<size_t>(y)] = ray_y(camera, y);
   for (const Run& run : runs) {
+    if (!measured(run.component)) continue;
     ComponentSums& s = sums[static_cast<size_t>(run.component)];
-    if (s.area < min_size) continue;
     const int n = run.x1 - run.x0;
     const float* nx = normals[0].ptr<float>(run.y) + run.x0;
     const float* ny = normals[1].ptr<float>(run.y) + run.x0;
@@ -189,9 +213,14 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
   for (int c = 1; c < count; ++c) {
     ComponentSums& s = sums[static_cast<size_t>(c)];
     if (s.area < min_size) continue;
+    new_id[static_cast<size_t>(c)] = static_cast<int>(out.patches.size()) + 1;
+    if (const int old = same_as[static_cast<size_t>(c)]; old > 0) {
+      out.patches.push_back(std::move(previous->patches[static_cast<size_t>(old - 1)]));
+      out.patches.back().id = new_id[static_cast<size_t>(c)];
+      continue;
+    }
     Patch p;
-    p.id = static_cast<int>(out.patches.size()) + 1;
-    new_id[static_cast<size_t>(c)] = p.id;
+    p.id = new_id[static_cast<size_t>(c)];
     p.bbox = cv::Rect(s.x0, s.y0, s.x1 - s.x0 + 1, s.y1 - s.y0 + 1);
     const double n = s.area;
     const Eigen::Vector3d normal_sum(s.normal[0], s.normal[1], s.normal[2]);
@@ -226,6 +255,20 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
   }
   std::fill(labels + done, labels + edges.total(), 0);
   return out;
+}
+
+}  // namespace
+
+Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
+                        const NormalPlanes& normals, const Params::Patches& params, int min_size) {
+  return build_patches(edges, depth, camera, normals, params, min_size, nullptr);
+}
+
+Patches update_patches(Patches previous, const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
+                       const NormalPlanes& normals, const Params::Patches& params, int min_size) {
+  if (previous.labels.size() != edges.size() || previous.labels.type() != CV_32S)
+    throw Error("update_patches: the previous patch image must be CV_32S of the edges' size");
+  return build_patches(edges, depth, camera, normals, params, min_size, &previous);
 }
 
 }  // namespace clutterseg

@@ -110,8 +110,9 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
                   (p.patches.split_band > 0 ? split_at_planes(r.edges, r.patches, r.core_patch_labels, r.points,   // patches
                                                               p.patches.split_band, px.area(p.patches.min_size_px),  // of two
                                                               table, p.support) : 0);                                 // planes
-  if (cut > 0) {
-    patches = extract_patches(r.edges, r.depth, camera, r.normals, p.patches, px.area(p.patches.min_size_px));
+  if (cut > 0) {  // measure again only the patches the cuts went through
+    patches = update_patches({r.core_patch_labels, std::move(r.patches)}, r.edges, r.depth, camera, r.normals,
+                             p.patches, px.area(p.patches.min_size_px));
     r.core_patch_labels = patches.labels;
     r.patches = std::move(patches.patches);
   }

@@ -374,3 +374,44 @@ TEST(Temporal, MovingBoxLeavesNoSmearAndStaticTableGetsQuieter) {
   };
   EXPECT_LT(noise(out), 0.5 * noise(raw));  // 1/sqrt(6) = 0.41
 }
+
+TEST(Patches, UpdateAfterCutsEqualsAFreshExtraction) {
+  // The table cut and the split at planes add edge pixels inside some patches; update_patches measures
+  // only those again and must give exactly what extract_patches gives on the new edges: same ids, pixels
+  // and statistics for every patch, the untouched ones included (they keep their old numbers otherwise).
+  const scenes::TestScene scene = scenes::staircase();
+  const auto truth = scene.render();
+  const Params params;
+  const NormalPlanes normals = compute_normals(truth.depth, scene.camera, 1, 5, 0.05f);
+  cv::Mat edges = edge_mask(normal_edge_value(normals, 2), truth.depth, params.edges.theta, 0.05f);
+  Patches before = extract_patches(edges, truth.depth, scene.camera, normals, params.patches, 20);
+  ASSERT_GE(before.patches.size(), 4u);
+  // Cut the largest patch (the table) and one other across with a line of edge pixels, as the cuts do.
+  const auto largest = std::max_element(before.patches.begin(), before.patches.end(),
+                                        [](const Patch& a, const Patch& b) { return a.pixels.size() < b.pixels.size(); });
+  for (const Patch* cut : {&*largest, &before.patches[1]})
+    for (int y = cut->bbox.y; y < cut->bbox.y + cut->bbox.height; ++y) {
+      const int x = cut->bbox.x + cut->bbox.width / 2;
+      if (before.labels.at<int>(y, x) == cut->id) edges.at<uchar>(y, x) = 255;
+    }
+  const Patches fresh = extract_patches(edges, truth.depth, scene.camera, normals, params.patches, 20);
+  const Patches updated = update_patches(before, edges, truth.depth, scene.camera, normals, params.patches, 20);
+  EXPECT_GT(fresh.patches.size(), before.patches.size());  // the cuts split patches
+  EXPECT_EQ(cv::countNonZero(fresh.labels != updated.labels), 0);
+  ASSERT_EQ(fresh.patches.size(), updated.patches.size());
+  for (size_t k = 0; k < fresh.patches.size(); ++k) {
+    const Patch &a = fresh.patches[k], &b = updated.patches[k];
+    EXPECT_EQ(a.id, b.id);
+    EXPECT_EQ(a.pixels, b.pixels);
+    EXPECT_EQ(a.centroid, b.centroid);
+    EXPECT_EQ(a.mean_normal, b.mean_normal);
+    EXPECT_EQ(a.spread_deg, b.spread_deg);
+    EXPECT_EQ(a.histogram, b.histogram);
+    EXPECT_EQ(a.occupied_bins, b.occupied_bins);
+    EXPECT_EQ(a.curved, b.curved);
+    EXPECT_EQ(a.bbox, b.bbox);
+  }
+  // A previous patch image that does not fit the edges is refused.
+  EXPECT_THROW(update_patches(before, edges(cv::Rect(0, 0, 10, 10)).clone(), truth.depth, scene.camera, normals,
+                              params.patches, 20), Error);
+}

@@ -19,6 +19,12 @@ struct Patches {
 Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
                         const NormalPlanes& normals, const Params::Patches& params, int min_size);
 
+// extract_patches on `edges` after edge pixels were added inside some of `previous`'s patches (the table cut,
+// the split at planes; never removed): the same result, but a patch no new edge pixel touched keeps its
+// statistics instead of being measured again.
+Patches update_patches(Patches previous, const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
+                       const NormalPlanes& normals, const Params::Patches& params, int min_size);
+
 // The bin of a unit normal (x, y, z) in the (x, y) histogram of normals: bins x bins cells over [-1, 1]^2.
 inline int normal_bin(float x, float y, int bins) {
   auto bin = [bins](float c) { return std::clamp(static_cast<int>((c + 1.f) * 0.5f * bins), 0, bins - 1); };
