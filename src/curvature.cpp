@@ -51,8 +51,9 @@ std::vector<std::vector<cv::Point>> boundaries(const cv::Mat& labels, const std:
     const int* row = labels.ptr<int>(y);
     const bool inner_row = y > 0 && y + 1 < labels.rows;
     if (inner_row) differs_from_neighbours(labels.ptr<int>(y - 1), row, labels.ptr<int>(y + 1), cols, on_edge.data());
-    for (int x = 0; x < cols; ++x) {
-      if (inner_row && !on_edge[static_cast<size_t>(x)]) continue;
+    // Inside the image only the marked pixels, found eight bytes at a time (most pixels are interior).
+    for (int x = inner_row ? first_nonzero(on_edge.data(), 0, cols) : 0; x < cols;
+         x = inner_row ? first_nonzero(on_edge.data(), x + 1, cols) : x + 1) {
       const int id = row[x];
       if (id > 0 && id <= max_id && wanted[static_cast<size_t>(id - 1)])
         out[static_cast<size_t>(id - 1)].emplace_back(x, y);
