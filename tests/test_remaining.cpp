@@ -81,6 +81,25 @@ TEST(Remaining, Rule3EnclosedBecomesObjectElseJoins) {
   EXPECT_EQ(e.run({0}, 1).at<int>(14, 18), 2);
 }
 
+// Beyond the paper (Params::Remaining::occluded_jump): a segment seen behind its one face across a depth
+// jump is an object that face hides (a box nearly hidden behind a taller one), not a part of the face; in
+// front of it, or behind by less than the jump, it joins the face as in rule 3.
+TEST(Remaining, ASegmentHiddenBehindItsOneFaceIsAnObjectOfItsOwn) {
+  const auto run = [](float z, double jump) {
+    Case c;
+    c.labels.setTo(1);
+    c.labels(cv::Rect(0, 10, 8, 8)).setTo(0);  // 64 px at the image border: not enclosed
+    c.depth(cv::Rect(0, 10, 8, 8)).setTo(z);
+    Params::Remaining params;
+    params.occluded_jump = jump;
+    return assign_remaining(c.labels, {0}, 1, c.points(), NormalPlanes{}, params, 20).at<int>(14, 3);
+  };
+  EXPECT_EQ(run(1.10f, 0.03), 2);  // 10 cm behind: hidden by the face
+  EXPECT_EQ(run(1.10f, 0), 1);     // off: rule 3, not enclosed, joins
+  EXPECT_EQ(run(1.02f, 0.03), 1);  // 2 cm behind: within the jump
+  EXPECT_EQ(run(0.90f, 0.03), 1);  // in front of the face
+}
+
 TEST(Remaining, Rule4SeveralNeighboursOfOneObjectJoinIt) {
   Case c;  // patches 1 and 2 (both object 0) left and right of a band 3 cm in front
   c.labels.colRange(0, 18).setTo(1);

@@ -115,6 +115,9 @@ struct Params {
                                  // wide as the projector's shadow (f_x b (1/z_near - 1/z_far) + hole_px / 2),
                                  // is the shadow on the farther object, and that object's (holes.hpp) [m];
                                  // 0 = off (needs hole_px > 0)
+    double occluded_jump = 0.03; // beyond the paper: a segment whose only neighbouring face (rules 2-3) touches
+                                 // it mostly across depth jumps larger than this, the segment behind, is an
+                                 // object that face hides, not a part of it [m]; 0 = off (remaining.hpp)
   } remaining;
 
   // Beyond the paper: the support plane (table), decided per patch before the graph (support.hpp).
