@@ -18,6 +18,8 @@
 //   meets in a convex edge (n_s - n_f) . (c_s - c_f) > 0, as faces of one object meet, not the table or
 //   the object it stands against (a concave crease).
 // - Beyond the paper: a table face (TableHint) takes no pixel standing clear of the table's plane.
+// - Beyond the paper: in rules 2-3 a segment seen behind its one face across depth jumps (most of its
+//   contacts with it, Params::Remaining::occluded_jump) is an object that face hides, not a part of it.
 // - Rule 5 is otherwise decided per pixel, not per segment: the remaining pixels between two objects are mostly
 //   a bold edge band that belongs half to each, and boundaries decide the metrics. The plane of each
 //   neighbouring face is a least-squares fit to that face's pixels near the segment (local, so a
