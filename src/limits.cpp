@@ -75,6 +75,8 @@ void validate(const Params& p) {
   in_range("remaining.grow_distance", p.remaining.grow_distance, 0, 1);
   int_range("remaining.tiny_px", p.remaining.tiny_px, 0, 100000);
   int_range("remaining.hole_px", p.remaining.hole_px, 0, 1000);
+  in_range("remaining.shadow_baseline", p.remaining.shadow_baseline, -1, 1);
+  in_range("remaining.occluded_jump", p.remaining.occluded_jump, 0, 1);
   above("support.plane_band", p.support.plane_band, 0, 1);
   in_range("support.pixel_band", p.support.pixel_band, 0, 1);
   in_range("support.table_angle_deg", p.support.table_angle_deg, 0, 90);

@@ -161,7 +161,8 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
     classify_objects(r.objects, r.patches, r.object_labels, r.points, support_of(*table, r.patches, r.points, p.support),
                      p.support);
   if (p.remaining.hole_px > 0)                                                   // pixels without depth
-    fill_depth_holes(r.object_labels, r.depth, r.objects, px.length(p.remaining.hole_px));  // (beyond the paper)
+    fill_depth_holes(r.object_labels, r.depth, r.objects, px.length(p.remaining.hole_px),  // (beyond the paper)
+                     camera.fx * p.remaining.shadow_baseline);
   watch.mark("objects");
   if (p.tracking.enabled && !r.object_labels.empty()) {                          // stable ids (beyond the paper)
     if (p.smoothing.temporal ? temporal_.restarted() : tracked_depth_.empty() || scene_changed(tracked_depth_, depth, p.smoothing))

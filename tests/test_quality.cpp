@@ -54,12 +54,13 @@ TEST(Quality, HandLabelledOsdFrames) {
   const Totals t = score(dev / "osd-kinect" / "depth", fs::path(CLUTTERSEG_SOURCE_DIR) / "data/handlabelled/osd-kinect/label",
                          read_camera_json(dev / "osd-kinect" / "camera.json"), false);
   ASSERT_EQ(t.frames, 5);
-  // docs/RESULTS.md, "The hand-labelled regression set": F 85.6, tp 90.3, fp 21.6, 9 objects in merges (of 46),
+  // docs/RESULTS.md, "The hand-labelled regression set": F 85.4, tp 90.3, fp 22.0, 9 objects in merges (of 46),
   // table in objects 0.6 %; before issue 14: F 81, fp 25, 14 merged, 1.9 %. (Its labels leave pixels without
-  // depth at 0, so the hole fill of remaining.hole_px costs it 0.3 F and 0.6 fp: RESULTS.md section 7.)
+  // depth at 0, so the hole fill of remaining.hole_px costs it 0.3 F and 0.6 fp, and the shadow fill of
+  // remaining.shadow_baseline 0.2 F and 0.4 fp: RESULTS.md sections 7 and 8.)
   EXPECT_GE(t.overlap_f, 0.85);
   EXPECT_GE(t.tp, 0.89);
-  EXPECT_LE(t.fp, 0.22);
+  EXPECT_LE(t.fp, 0.225);
   EXPECT_LE(t.merged_objects, 9);
   EXPECT_LE(t.background, 0.01);
 }

@@ -81,6 +81,25 @@ TEST(Remaining, Rule3EnclosedBecomesObjectElseJoins) {
   EXPECT_EQ(e.run({0}, 1).at<int>(14, 18), 2);
 }
 
+// Beyond the paper (Params::Remaining::occluded_jump): a segment seen behind its one face across a depth
+// jump is an object that face hides (a box nearly hidden behind a taller one), not a part of the face; in
+// front of it, or behind by less than the jump, it joins the face as in rule 3.
+TEST(Remaining, ASegmentHiddenBehindItsOneFaceIsAnObjectOfItsOwn) {
+  const auto run = [](float z, double jump) {
+    Case c;
+    c.labels.setTo(1);
+    c.labels(cv::Rect(0, 10, 8, 8)).setTo(0);  // 64 px at the image border: not enclosed
+    c.depth(cv::Rect(0, 10, 8, 8)).setTo(z);
+    Params::Remaining params;
+    params.occluded_jump = jump;
+    return assign_remaining(c.labels, {0}, 1, c.points(), NormalPlanes{}, params, 20).at<int>(14, 3);
+  };
+  EXPECT_EQ(run(1.10f, 0.03), 2);  // 10 cm behind: hidden by the face
+  EXPECT_EQ(run(1.10f, 0), 1);     // off: rule 3, not enclosed, joins
+  EXPECT_EQ(run(1.02f, 0.03), 1);  // 2 cm behind: within the jump
+  EXPECT_EQ(run(0.90f, 0.03), 1);  // in front of the face
+}
+
 TEST(Remaining, Rule4SeveralNeighboursOfOneObjectJoinIt) {
   Case c;  // patches 1 and 2 (both object 0) left and right of a band 3 cm in front
   c.labels.colRange(0, 18).setTo(1);
@@ -196,4 +215,46 @@ TEST(Remaining, HolesEnclosedByOneObjectJoinIt) {
   EXPECT_EQ(cv::countNonZero(labels(cv::Rect(28, 5, 3, 10))), 0);   // between an object and the table
   EXPECT_EQ(cv::countNonZero(labels(cv::Rect(34, 8, 2, 3))), 0);    // in the table
   EXPECT_EQ(fill_depth_holes(labels, depth, objects, 0), 0);         // 0: off
+}
+
+// Beyond the paper (holes.hpp, Params::Remaining::shadow_baseline): the projector of a structured-light
+// sensor, b along +x, cannot light the strip of a farther object left of an occluder's edge, f b (1/z_near -
+// 1/z_far) pixels wide. That strip is the farther object's but for the 30 % next to the occluder (its side
+// face may be there, unlit too); a run on the other side of the occluder, one wider than the shadow can be,
+// or one between two objects at one depth is not a shadow and stays 0.
+TEST(Remaining, TheProjectorsShadowOnAFartherObjectIsThatObjects) {
+  constexpr double kFocal = 525 * 0.075;          // a VGA Kinect v1: f_x b [px m]
+  cv::Mat labels(12, 80, CV_32S, cv::Scalar(0));
+  cv::Mat depth(12, 80, CV_32F, cv::Scalar(0.f));
+  // Row block 0-3: far object 1 (1.2 m), a 12 px shadow, near object 2 (0.8 m) - the shadow is up to
+  // 525 * 0.075 * (1/0.8 - 1/1.2) = 16.4 px wide.
+  labels(cv::Rect(0, 0, 20, 4)).setTo(1);   depth(cv::Rect(0, 0, 20, 4)).setTo(1.2f);
+  labels(cv::Rect(32, 0, 20, 4)).setTo(2);  depth(cv::Rect(32, 0, 20, 4)).setTo(0.8f);
+  // Rows 4-7: mirrored, near object 2 left of far object 1: the projector lights that side.
+  labels(cv::Rect(0, 4, 20, 4)).setTo(2);   depth(cv::Rect(0, 4, 20, 4)).setTo(0.8f);
+  labels(cv::Rect(32, 4, 20, 4)).setTo(1);  depth(cv::Rect(32, 4, 20, 4)).setTo(1.2f);
+  // Rows 8-11: objects 1 and 3 at one depth (no occluder), then far 1, 30 px, near 2 (too wide).
+  labels(cv::Rect(0, 8, 20, 4)).setTo(1);   depth(cv::Rect(0, 8, 20, 4)).setTo(1.0f);
+  labels(cv::Rect(32, 8, 10, 4)).setTo(3);  depth(cv::Rect(32, 8, 10, 4)).setTo(1.0f);
+  labels(cv::Rect(42, 8, 8, 4)).setTo(1);   depth(cv::Rect(42, 8, 8, 4)).setTo(1.2f);
+  labels(cv::Rect(78, 8, 2, 4)).setTo(2);   depth(cv::Rect(78, 8, 2, 4)).setTo(0.8f);
+  std::vector<Object> objects(3);
+  for (int k = 0; k < 3; ++k) objects[static_cast<size_t>(k)].id = k + 1;
+  cv::Mat off = labels.clone();
+  std::vector<Object> copy = objects;
+  EXPECT_EQ(fill_depth_holes(off, depth, copy, 3), 0);                  // no shadow rule: runs > 3 px stay
+  EXPECT_EQ(fill_depth_holes(labels, depth, objects, 3, kFocal), 4 * 8);
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(20, 0, 8, 4)) == 1), 4 * 8);  // the shadow: the far object's
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(28, 0, 4, 4))), 0);          // 30 % next to the occluder
+  EXPECT_EQ(objects[0].pixel_count, 4 * 8);
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(20, 4, 12, 4))), 0);     // the lit side of the occluder
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(20, 8, 12, 4))), 0);     // no occluder
+  EXPECT_EQ(cv::countNonZero(labels(cv::Rect(50, 8, 28, 4))), 0);     // wider than a shadow can be
+  cv::Mat mirrored = off.clone();
+  cv::Mat mirrored_depth = depth.clone();
+  cv::flip(off, mirrored, 1);
+  cv::flip(depth, mirrored_depth, 1);
+  copy = objects;
+  EXPECT_EQ(fill_depth_holes(mirrored, mirrored_depth, copy, 3, -kFocal), 4 * 8);  // projector along -x
+  EXPECT_EQ(cv::countNonZero(mirrored(cv::Rect(52, 0, 8, 4)) == 1), 4 * 8);
 }

@@ -17,6 +17,12 @@ namespace clutterseg {
 // object in the sensor's shadow are whole, while a shadow between an object and the table (table on one
 // side) or between two objects stays unlabelled. object_labels: CV_32S 1..M, objects[k - 1] is label k;
 // its pixel_count grows by the pixels it takes. Returns the number of pixels labelled. Deterministic.
-int fill_depth_holes(cv::Mat& object_labels, const cv::Mat& depth, std::vector<Object>& objects, int max_run);
+// shadow_focal = f_x * b [px m] of a structured-light sensor whose projector is b metres along +x of the
+// depth camera (negative: along -x; 0 = off): a row's run between a near and a farther object, on the far
+// object's side away from the projector and at most f_x b (1/z_near - 1/z_far) + max_run / 2 pixels long, is
+// the projector's shadow on the farther object, and is that object's but for the 30 % next to the occluder
+// (its side face may be there, unlit too) (Params::Remaining::shadow_baseline).
+int fill_depth_holes(cv::Mat& object_labels, const cv::Mat& depth, std::vector<Object>& objects, int max_run,
+                     double shadow_focal = 0);
 
 }  // namespace clutterseg

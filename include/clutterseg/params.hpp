@@ -109,6 +109,15 @@ struct Params {
     int hole_px = 4;             // beyond the paper: a run of pixels without depth at most this long
                                  // with one object on both ends (row or column) is that object's
                                  // (holes.hpp); at 320x240 [px], scaled; 0 = pixels without depth stay 0
+    double shadow_baseline = 0.075;  // beyond the paper: the projector of a structured-light sensor lies this
+                                 // far along +x of the depth camera (Kinect v1, Xtion: 7.5 cm; negative =
+                                 // along -x). A row's run without depth left of a nearer object, at most as
+                                 // wide as the projector's shadow (f_x b (1/z_near - 1/z_far) + hole_px / 2),
+                                 // is the shadow on the farther object, and that object's (holes.hpp) [m];
+                                 // 0 = off (needs hole_px > 0)
+    double occluded_jump = 0.03; // beyond the paper: a segment whose only neighbouring face (rules 2-3) touches
+                                 // it mostly across depth jumps larger than this, the segment behind, is an
+                                 // object that face hides, not a part of it [m]; 0 = off (remaining.hpp)
   } remaining;
 
   // Beyond the paper: the support plane (table), decided per patch before the graph (support.hpp).

@@ -21,8 +21,9 @@ struct TableHint {
 // the unassigned valid pixels (grow_distance in 3D per pixel step, across single missing pixels) and
 // applying the paper's five rules; new objects get ids after the existing ones. A segment of several
 // objects' faces that is a face of its own (its normals differ from every neighbouring face's) joins the
-// face it meets in a convex edge (beyond the paper; docs/OBJECTS.md). tiny_px is already scaled to the
-// resolution. normals may be empty (no face-of-its-own rule).
+// face it meets in a convex edge, and a segment seen behind its one face across depth jumps larger than
+// params.occluded_jump is an object of its own (both beyond the paper; docs/OBJECTS.md). tiny_px is
+// already scaled to the resolution. normals may be empty (no face-of-its-own rule).
 cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
                          int num_objects, const cv::Mat& points, const NormalPlanes& normals,
                          const Params::Remaining& params, int tiny_px, const std::optional<TableHint>& table = {});
