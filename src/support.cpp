@@ -429,9 +429,9 @@ void separate_marked(cv::Mat& edges, const cv::Mat& mark_image, const cv::Mat& p
   uchar* edge = edges.ptr<uchar>();
   const int width = patch_labels.cols, height = patch_labels.rows;
   for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
+    // Marked pixels are few: the rest of a row is skipped eight at a time.
+    for (int x = first_nonzero(mark + y * width, 0, width); x < width; x = first_nonzero(mark + y * width, x + 1, width)) {
       const int i = y * width + x;
-      if (!mark[i]) continue;
       const int neighbours[4] = {x > 0 ? i - 1 : -1, x + 1 < width ? i + 1 : -1, y > 0 ? i - width : -1,
                                  y + 1 < height ? i + width : -1};
       for (int j : neighbours)
@@ -460,12 +460,32 @@ std::vector<int> off_plane(const std::vector<int>& pixels, const cv::Vec3f* pts,
 
 namespace {
 
-// above[i] = 255 where point i (interleaved xyz) is valid and higher above the plane than k * max(1, z^2).
-CLUTTERSEG_ROW_KERNEL void mark_above_plane(const float* __restrict xyz, int n, float a, float b, float c, float d,
-                                            float k, uchar* __restrict above) {
+// above[i] = 255 where point i (interleaved xyz) is valid and higher above the plane than k * max(1, z^2);
+// returns how many are.
+CLUTTERSEG_ROW_KERNEL int mark_above_plane(const float* __restrict xyz, int n, float a, float b, float c, float d,
+                                           float k, uchar* __restrict above) {
+  int count = 0;
   for (int i = 0; i < n; ++i) {
     const float x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
-    above[i] = valid_depth(z) & (a * x + b * y + c * z + d > k * std::max(1.f, z * z)) ? 255 : 0;
+    const bool is_above = valid_depth(z) & (a * x + b * y + c * z + d > k * std::max(1.f, z * z));
+    above[i] = is_above ? 255 : 0;
+    count += is_above;
+  }
+  return count;
+}
+
+// Calls visit(first, count) for each run of consecutive indices in `pixels` (increasing, as a patch's
+// pixels are: its row segments). Strictly increasing indices 8 apart in value and in position have no
+// gap between them, so a run is crossed eight at a time.
+template <class Visit>
+void for_each_pixel_run(const std::vector<int>& pixels, Visit visit) {
+  const size_t n = pixels.size();
+  for (size_t begin = 0; begin < n;) {
+    size_t end = begin + 1;
+    while (end + 8 <= n && pixels[end + 7] - pixels[end - 1] == 8) end += 8;
+    while (end < n && pixels[end] == pixels[end - 1] + 1) ++end;
+    visit(pixels[begin], static_cast<int>(end - begin));
+    begin = end;
   }
 }
 
@@ -473,20 +493,22 @@ CLUTTERSEG_ROW_KERNEL void mark_above_plane(const float* __restrict xyz, int n, 
 
 int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                   const Plane& plane, const Params::Support& params, int min_px) {
-  // Every pixel's height once, in one vectorised pass; then the table patches' pixels are looked up.
-  cv::Mat above(patch_labels.size(), CV_8U);
-  mark_above_plane(points.ptr<float>(), static_cast<int>(points.total()), plane.normal.x(), plane.normal.y(),
-                   plane.normal.z(), plane.offset, static_cast<float>(params.plane_band), above.ptr<uchar>());
-  const uchar* is_above = above.ptr<uchar>();
+  // Heights of the table patches' pixels only, run by run (vectorised).
+  const auto* xyz = points.ptr<float>();
   cv::Mat clear(patch_labels.size(), CV_8U, cv::Scalar(0));  // core pixels of table patches clear of the plane
   uchar* mark = clear.ptr<uchar>();
   int cut = 0;
   for (const int p : patches_near(patches, points, plane, params)) {
     const auto& pixels = patches[static_cast<size_t>(p)].pixels;
     int count = 0;
-    for (int i : pixels) count += is_above[i] != 0;
-    if (count < min_px) continue;
-    for (int i : pixels) mark[i] = is_above[i];
+    for_each_pixel_run(pixels, [&](int first, int n) {
+      count += mark_above_plane(xyz + 3 * static_cast<size_t>(first), n, plane.normal.x(), plane.normal.y(),
+                                plane.normal.z(), plane.offset, static_cast<float>(params.plane_band), mark + first);
+    });
+    if (count < min_px) {
+      for_each_pixel_run(pixels, [&](int first, int n) { std::memset(mark + first, 0, static_cast<size_t>(n)); });
+      continue;
+    }
     cut += count;
   }
   if (cut > 0) separate_marked(edges, clear, patch_labels);
