@@ -537,6 +537,16 @@ int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv:
   return cut;
 }
 
+namespace {
+
+// differs[i] = 1 where a[i] != b[i].
+CLUTTERSEG_ROW_KERNEL void mark_differing(const int* __restrict a, const int* __restrict b, int n,
+                                          std::uint8_t* __restrict differs) {
+  for (int i = 0; i < n; ++i) differs[i] = a[i] != b[i];
+}
+
+}  // namespace
+
 int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, const std::vector<Patch>& patches,
                        const cv::Mat& points, const Plane& plane, const Params::Support& params) {
   const auto* pts = points.ptr<cv::Vec3f>();
@@ -547,17 +557,14 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
   const auto k = static_cast<float>(params.pixel_band);
   std::vector<std::uint8_t> table(static_cast<size_t>(num_patches) + 1, 0);
   for (int p = 0; p < num_patches; ++p) table[static_cast<size_t>(p) + 1] = patches[static_cast<size_t>(p)].table;
+  // Only edge pixels can be released: those whose label differs from the core label, marked in a
+  // vectorised pass and then visited eight bytes at a time.
+  std::vector<std::uint8_t> differs(static_cast<size_t>(total));
+  mark_differing(lab, core, total, differs.data());
   int released = 0;
-  // Only edge pixels can be released: 32 labels at a time are compared with the core labels (memcmp),
-  // and the pixels of a block that differs are looked at.
-  constexpr int kBlock = 32;
-  for (int i = 0; i < total; ++i) {
-    if (i % kBlock == 0 && i + kBlock <= total && std::memcmp(lab + i, core + i, kBlock * sizeof(int)) == 0) {
-      i += kBlock - 1;
-      continue;
-    }
+  for (int i = first_nonzero(differs.data(), 0, total); i < total; i = first_nonzero(differs.data(), i + 1, total)) {
     const int l = lab[i];
-    if (l == core[i] || l <= 0 || l > num_patches) continue;  // a core pixel, or no patch: not an edge pixel's
+    if (l <= 0 || l > num_patches) continue;  // no patch
     const float x = pts[i][0], y = pts[i][1], z = pts[i][2];
     if (!table[static_cast<size_t>(l)] || a * x + b * y + c * z + d <= k * std::max(1.f, z * z)) continue;
     lab[i] = 0;
