@@ -37,12 +37,19 @@ inline bool valid_depth(float z) { return (z > 0) & (z < std::numeric_limits<flo
 inline bool valid_point(const cv::Vec3f& p) { return valid_depth(p[2]); }
 
 // End of the run of labels equal to lab[begin] within [begin, end). Label images come in long runs
-// (the row segments of patches and objects): four labels per step, the OR of differences is 0 only
-// when all four match (branch-free).
+// (the row segments of patches and objects): eight labels per step, read as four 64-bit words each
+// holding two labels; the OR of differences is 0 only when all eight match (branch-free).
 inline int run_end(const int* lab, int begin, int end) {
   const int id = lab[begin];
+  const int two[2] = {id, id};
+  std::uint64_t pair;
+  std::memcpy(&pair, two, sizeof pair);
   int k = begin + 1;
-  while (k + 4 <= end && ((lab[k] ^ id) | (lab[k + 1] ^ id) | (lab[k + 2] ^ id) | (lab[k + 3] ^ id)) == 0) k += 4;
+  for (; k + 8 <= end; k += 8) {
+    std::uint64_t w[4];
+    std::memcpy(w, lab + k, sizeof w);
+    if (((w[0] ^ pair) | (w[1] ^ pair) | (w[2] ^ pair) | (w[3] ^ pair)) != 0) break;
+  }
   while (k < end && lab[k] == id) ++k;
   return k;
 }
