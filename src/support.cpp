@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <opencv2/imgproc.hpp>
 
 #include "clutterseg/parallel.hpp"
@@ -141,14 +142,57 @@ CLUTTERSEG_ROW_KERNEL int count_within(const float* __restrict x, const float* _
   return count;
 }
 
-// Every stride-th valid pixel of a patch, at most about `most` of them (bounded work per patch).
-std::vector<int> sample_of(const std::vector<int>& pixels, const cv::Vec3f* pts, size_t most) {
+// Every stride-th valid pixel of `lists` taken as one list (not copied into one: a copy of every table
+// pixel was most of support_of), at most about `most` of them (bounded work per patch).
+std::vector<int> sample_of(std::span<const std::vector<int>* const> lists, const cv::Vec3f* pts, size_t most) {
+  size_t total = 0;
+  for (const std::vector<int>* pixels : lists) total += pixels->size();
+  const size_t stride = std::max<size_t>(1, total / most);
   std::vector<int> sample;
-  const size_t stride = std::max<size_t>(1, pixels.size() / most);
-  for (size_t k = 0; k < pixels.size(); k += stride)
-    if (valid_point(pts[pixels[k]])) sample.push_back(pixels[k]);
+  sample.reserve(total / stride + 1);
+  size_t k = 0;  // the next index to visit, counted from the start of the current list
+  for (const std::vector<int>* pixels : lists) {
+    for (; k < pixels->size(); k += stride)
+      if (valid_point(pts[(*pixels)[k]])) sample.push_back((*pixels)[k]);
+    k -= pixels->size();
+  }
   return sample;
 }
+
+std::vector<int> sample_of(const std::vector<int>& pixels, const cv::Vec3f* pts, size_t most) {
+  const std::vector<int>* one[] = {&pixels};
+  return sample_of(one, pts, most);
+}
+
+// Sums for a least-squares plane: the points and their outer products, of which only the six distinct
+// entries are summed (the matrix is symmetric: the other three would repeat the same products).
+struct PlaneFit {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  long n = 0;
+  void add(const Eigen::Vector3f& point) {
+    const Eigen::Vector3d q = point.cast<double>();
+    sum += q;
+    xx += q.x() * q.x(); xy += q.x() * q.y(); xz += q.x() * q.z();
+    yy += q.y() * q.y(); yz += q.y() * q.z(); zz += q.z() * q.z();
+    ++n;
+  }
+  // The plane through the mean, normal along the axis of least variance, facing the camera; false for
+  // fewer than 10 points or points along a line.
+  bool plane(Plane& plane) const {
+    if (n < 10) return false;
+    const Eigen::Vector3d mean = sum / static_cast<double>(n);
+    Eigen::Matrix3d outer;
+    outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / static_cast<double>(n) - mean * mean.transpose());
+    if (eig.eigenvalues()(1) < 1e-8) return false;
+    Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    if (normal.dot(mean) > 0) normal = -normal;
+    plane.normal = normal.cast<float>();
+    plane.offset = static_cast<float>(-normal.dot(mean));
+    return true;
+  }
+};
 
 // Dominant plane of a patch: RANSAC over a sample of its points (a table patch may hold the foot of an
 // object that the edges did not separate), refined by least squares on the inliers. The band grows with
@@ -207,39 +251,28 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
 bool refit(const std::vector<Patch>& patches, const std::vector<int>& table, const cv::Mat& points, double band,
            Plane& plane) {
   const auto* pts = points.ptr<cv::Vec3f>();
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  long n = 0;
+  PlaneFit fit;
   for (int p : table)
     for (int i : sample_of(patches[static_cast<size_t>(p)].pixels, pts, 3000)) {
       const Eigen::Vector3f q = point_at(pts, i);
-      if (std::abs(plane.distance(q)) > plane_tolerance(band, q.z())) continue;
-      const Eigen::Vector3d d = q.cast<double>();
-      sum += d;
-      outer += d * d.transpose();
-      ++n;
+      if (std::abs(plane.distance(q)) <= plane_tolerance(band, q.z())) fit.add(q);
     }
-  if (n < 10) return false;
-  const Eigen::Vector3d mean = sum / static_cast<double>(n);
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / static_cast<double>(n) - mean * mean.transpose());
-  if (eig.eigenvalues()(1) < 1e-8) return false;
-  Eigen::Vector3d normal = eig.eigenvectors().col(0);
-  if (normal.dot(mean) > 0) normal = -normal;
-  plane.normal = normal.cast<float>();
-  plane.offset = static_cast<float>(-normal.dot(mean));
-  return true;
+  return fit.plane(plane);
 }
 
-// The patches a plane's refit is made from: normal close to the plane's, half of the points within the
+// A patch a plane's refit is made from: normal close to the plane's, half of the points within the
 // tolerance (a patch that holds an object's foot still counts).
+bool is_near(const Patch& patch, const cv::Mat& points, const Plane& plane, const Params::Support& params) {
+  const float min_cos = static_cast<float>(std::cos(params.table_angle_deg * M_PI / 180.0));
+  return patch.mean_normal.dot(plane.normal) >= min_cos && mostly_within(patch.pixels, points, plane, params.plane_band, 0.5);
+}
+
+// The patches that are is_near the plane.
 std::vector<int> patches_near(const std::vector<Patch>& patches, const cv::Mat& points, const Plane& plane,
                               const Params::Support& params) {
-  const float min_cos = static_cast<float>(std::cos(params.table_angle_deg * M_PI / 180.0));
   std::vector<int> near;
   for (size_t p = 0; p < patches.size(); ++p)
-    if (patches[p].mean_normal.dot(plane.normal) >= min_cos &&
-        mostly_within(patches[p].pixels, points, plane, params.plane_band, 0.5))
-      near.push_back(static_cast<int>(p));
+    if (is_near(patches[p], points, plane, params)) near.push_back(static_cast<int>(p));
   return near;
 }
 
@@ -248,25 +281,10 @@ std::vector<int> patches_near(const std::vector<Patch>& patches, const cv::Mat& 
 bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& plane) {
   const auto* pts = points.ptr<cv::Vec3f>();
   const size_t stride = std::max<size_t>(1, pixels.size() / 3000);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  int n = 0;
-  for (size_t k = 0; k < pixels.size(); k += stride) {
-    if (!valid_point(pts[pixels[k]])) continue;
-    const Eigen::Vector3d q = point_at(pts, pixels[k]).cast<double>();
-    sum += q;
-    outer += q * q.transpose();
-    ++n;
-  }
-  if (n < 10) return false;
-  const Eigen::Vector3d mean = sum / n;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / n - mean * mean.transpose());
-  if (eig.eigenvalues()(1) < 1e-8) return false;
-  Eigen::Vector3d normal = eig.eigenvectors().col(0);
-  if (normal.dot(mean) > 0) normal = -normal;
-  plane.normal = normal.cast<float>();
-  plane.offset = static_cast<float>(-normal.dot(mean));
-  return true;
+  PlaneFit fit;
+  for (size_t k = 0; k < pixels.size(); k += stride)
+    if (valid_point(pts[pixels[k]])) fit.add(point_at(pts, pixels[k]));
+  return fit.plane(plane);
 }
 
 bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double band,
@@ -275,26 +293,40 @@ bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const 
   const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
   const size_t visits = (pixels.size() + stride - 1) / stride;
   int in = 0, n = 0;
-  for (size_t v = 0; v < visits; ++v) {
-    const int i = pixels[v * stride];
-    if (!valid_point(pts[i])) continue;
-    ++n;
-    in += std::abs(plane.distance(point_at(pts, i))) <= plane_tolerance(band, pts[i][2]);
-    // Best final share (in + left) / (n + left); half a point of margin keeps rounding out of it.
-    const double left = static_cast<double>(visits - v - 1);
+  // Checked every kBlock visits: once the best final share (in + left) / (n + left) is below `share` it
+  // stays below (each visit lowers in + left - share * (n + left) or keeps it), so a later check gives
+  // the same answer with a cheaper loop. Half a point of margin keeps rounding out of it.
+  constexpr size_t kBlock = 16;
+  for (size_t block = 0; block < visits; block += kBlock) {
+    const size_t block_end = std::min(visits, block + kBlock);
+    for (size_t v = block; v < block_end; ++v) {
+      const int i = pixels[v * stride];
+      if (!valid_point(pts[i])) continue;
+      ++n;
+      in += std::abs(plane.distance(point_at(pts, i))) <= plane_tolerance(band, pts[i][2]);
+    }
+    const double left = static_cast<double>(visits - block_end);
     if (in + left < share * (n + left) - 0.5) return false;
   }
   return n && static_cast<double>(in) / n >= share;
 }
 
-PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin) {
+namespace {
+
+// Points a region is made from, at most about (the hull of a sample is the region's outline to within
+// the sample's spacing, a few millimetres).
+constexpr size_t kRegionSample = 4000;
+
+// The region of `sample` (valid pixels) in `plane`, grown by `margin` [m].
+PlaneRegion region_of_sample(const Plane& plane, const std::vector<int>& sample, const cv::Mat& points, double margin) {
   PlaneRegion r;
   r.plane = plane;
   r.u = plane.normal.unitOrthogonal();
   r.v = plane.normal.cross(r.u);
   const auto* pts = points.ptr<cv::Vec3f>();
   std::vector<cv::Point2f> projected;
-  for (int i : sample_of(pixels, pts, 4000)) {
+  projected.reserve(sample.size());
+  for (int i : sample) {
     const Eigen::Vector3f q = point_at(pts, i);
     projected.emplace_back(r.u.dot(q), r.v.dot(q));
   }
@@ -321,6 +353,12 @@ PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const 
   cv::fillConvexPoly(r.cells, poly, cv::Scalar(255));
   if (pad > 1) r.cells = dilate_by_spans(r.cells, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * pad - 1, 2 * pad - 1}));
   return r;
+}
+
+}  // namespace
+
+PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin) {
+  return region_of_sample(plane, sample_of(pixels, points.ptr<cv::Vec3f>(), kRegionSample), points, margin);
 }
 
 Eigen::Vector3f up_in_camera(const Camera& camera) {
@@ -520,12 +558,10 @@ int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv:
   const auto* pts = points.ptr<cv::Vec3f>();
   cv::Mat off(patch_labels.size(), CV_8U, cv::Scalar(0));  // pixels of flat patches off their dominant plane
   uchar* mark = off.ptr<uchar>();
-  const std::vector<int> near_table = table ? patches_near(patches, points, *table, support) : std::vector<int>{};
   int cut = 0;
-  for (size_t p = 0; p < patches.size(); ++p) {
-    const Patch& patch = patches[p];
+  for (const Patch& patch : patches) {
     if (patch.curved || static_cast<int>(patch.pixels.size()) < 2 * min_px) continue;  // a plane to split at
-    if (std::binary_search(near_table.begin(), near_table.end(), static_cast<int>(p))) continue;  // cut_off_table's
+    if (table && is_near(patch, points, *table, support)) continue;  // cut_off_table splits it at the table
     Plane plane;
     if (dominant_plane(patch.pixels, points, band, plane) < 0.6) continue;
     const std::vector<int> outside = off_plane(patch.pixels, pts, plane, band);
@@ -636,10 +672,11 @@ int settle_table(std::vector<Patch>& patches, const std::vector<std::pair<int, i
 
 Support support_of(const Plane& plane, const std::vector<Patch>& patches, const cv::Mat& points,
                    const Params::Support& params) {
-  std::vector<int> table_pixels;
+  std::vector<const std::vector<int>*> table_pixels;
   for (const auto& patch : patches)
-    if (patch.table) table_pixels.insert(table_pixels.end(), patch.pixels.begin(), patch.pixels.end());
-  return {plane, region_of(plane, table_pixels, points, params.region_margin)};
+    if (patch.table) table_pixels.push_back(&patch.pixels);
+  const std::vector<int> sample = sample_of(table_pixels, points.ptr<cv::Vec3f>(), kRegionSample);
+  return {plane, region_of_sample(plane, sample, points, params.region_margin)};
 }
 
 }  // namespace clutterseg
