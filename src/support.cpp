@@ -531,22 +531,31 @@ void for_each_pixel_run(const std::vector<int>& pixels, Visit visit) {
 
 int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                   const Plane& plane, const Params::Support& params, int min_px) {
-  // Heights of the table patches' pixels only, run by run (vectorised).
+  // Heights of the table patches' pixels only, run by run (vectorised), counted into a row-sized scratch
+  // line; the mark image is made only for a patch to cut (most frames have none).
   const auto* xyz = points.ptr<float>();
-  cv::Mat clear(patch_labels.size(), CV_8U, cv::Scalar(0));  // core pixels of table patches clear of the plane
-  uchar* mark = clear.ptr<uchar>();
+  std::array<uchar, 1024> scratch;  // marks of a piece of a run when only counting
+  // Pixels of `pixels` clear of the plane, marked in `image` (nullptr: counted only). Runs go in pieces
+  // that fit the scratch line (a run crosses rows where a patch spans them).
+  const auto above = [&](const std::vector<int>& pixels, uchar* image) {
+    int count = 0;
+    constexpr int kPiece = static_cast<int>(scratch.size());
+    for_each_pixel_run(pixels, [&](int first, int n) {
+      for (int begin = first; begin < first + n; begin += kPiece)
+        count += mark_above_plane(xyz + 3 * static_cast<size_t>(begin), std::min(kPiece, first + n - begin),
+                                  plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset,
+                                  static_cast<float>(params.plane_band), image ? image + begin : scratch.data());
+    });
+    return count;
+  };
+  cv::Mat clear;  // core pixels of table patches clear of the plane
   int cut = 0;
   for (const int p : patches_near(patches, points, plane, params)) {
     const auto& pixels = patches[static_cast<size_t>(p)].pixels;
-    int count = 0;
-    for_each_pixel_run(pixels, [&](int first, int n) {
-      count += mark_above_plane(xyz + 3 * static_cast<size_t>(first), n, plane.normal.x(), plane.normal.y(),
-                                plane.normal.z(), plane.offset, static_cast<float>(params.plane_band), mark + first);
-    });
-    if (count < min_px) {
-      for_each_pixel_run(pixels, [&](int first, int n) { std::memset(mark + first, 0, static_cast<size_t>(n)); });
-      continue;
-    }
+    const int count = above(pixels, nullptr);
+    if (count < min_px) continue;
+    if (clear.empty()) clear = cv::Mat(patch_labels.size(), CV_8U, cv::Scalar(0));
+    above(pixels, clear.ptr<uchar>());
     cut += count;
   }
   if (cut > 0) separate_marked(edges, clear, patch_labels);
@@ -556,8 +565,7 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
 int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                     double band, int min_px, const std::optional<Plane>& table, const Params::Support& support) {
   const auto* pts = points.ptr<cv::Vec3f>();
-  cv::Mat off(patch_labels.size(), CV_8U, cv::Scalar(0));  // pixels of flat patches off their dominant plane
-  uchar* mark = off.ptr<uchar>();
+  cv::Mat off;  // pixels of flat patches off their dominant plane; made for the first patch to split
   int cut = 0;
   for (const Patch& patch : patches) {
     if (patch.curved || static_cast<int>(patch.pixels.size()) < 2 * min_px) continue;  // a plane to split at
@@ -566,7 +574,8 @@ int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv:
     if (dominant_plane(patch.pixels, points, band, plane) < 0.6) continue;
     const std::vector<int> outside = off_plane(patch.pixels, pts, plane, band);
     if (static_cast<int>(outside.size()) < min_px) continue;
-    for (int i : outside) mark[i] = 255;
+    if (off.empty()) off = cv::Mat(patch_labels.size(), CV_8U, cv::Scalar(0));
+    for (int i : outside) off.ptr<uchar>()[i] = 255;
     cut += static_cast<int>(outside.size());
   }
   if (cut > 0) separate_marked(edges, off, patch_labels);
@@ -595,10 +604,11 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
   for (int p = 0; p < num_patches; ++p) table[static_cast<size_t>(p) + 1] = patches[static_cast<size_t>(p)].table;
   // Only edge pixels can be released: those whose label differs from the core label, marked in a
   // vectorised pass and then visited eight bytes at a time.
-  std::vector<std::uint8_t> differs(static_cast<size_t>(total));
-  mark_differing(lab, core, total, differs.data());
+  cv::Mat differs_image(assigned_labels.size(), CV_8U);  // every byte written: no zeroing
+  std::uint8_t* differs = differs_image.ptr<std::uint8_t>();
+  mark_differing(lab, core, total, differs);
   int released = 0;
-  for (int i = first_nonzero(differs.data(), 0, total); i < total; i = first_nonzero(differs.data(), i + 1, total)) {
+  for (int i = first_nonzero(differs, 0, total); i < total; i = first_nonzero(differs, i + 1, total)) {
     const int l = lab[i];
     if (l <= 0 || l > num_patches) continue;  // no patch
     const float x = pts[i][0], y = pts[i][1], z = pts[i][2];
