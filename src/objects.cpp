@@ -149,8 +149,9 @@ struct Moments {
 void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo, const std::vector<Run>& runs,
                      const cv::Mat& points, const Camera& camera) {
   // Coordinates as planes: the per-run loops below read them contiguously (and vectorise).
+  const cv::Mat cloud = points.isContinuous() ? points : points.clone();  // read as one array (an ROI is not)
   cv::Mat planes[3] = {cv::Mat(points.size(), CV_32F), cv::Mat(points.size(), CV_32F), cv::Mat(points.size(), CV_32F)};
-  deinterleave(points.ptr<float>(), static_cast<int>(points.total()), planes[0].ptr<float>(), planes[1].ptr<float>(),
+  deinterleave(cloud.ptr<float>(), static_cast<int>(cloud.total()), planes[0].ptr<float>(), planes[1].ptr<float>(),
                planes[2].ptr<float>());
   const float* px = planes[0].ptr<float>();
   const float* py = planes[1].ptr<float>();
