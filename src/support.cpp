@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <opencv2/imgproc.hpp>
 
 #include "clutterseg/parallel.hpp"
@@ -141,14 +142,57 @@ CLUTTERSEG_ROW_KERNEL int count_within(const float* __restrict x, const float* _
   return count;
 }
 
-// Every stride-th valid pixel of a patch, at most about `most` of them (bounded work per patch).
-std::vector<int> sample_of(const std::vector<int>& pixels, const cv::Vec3f* pts, size_t most) {
+// Every stride-th valid pixel of `lists` taken as one list (not copied into one: a copy of every table
+// pixel was most of support_of), at most about `most` of them (bounded work per patch).
+std::vector<int> sample_of(std::span<const std::vector<int>* const> lists, const cv::Vec3f* pts, size_t most) {
+  size_t total = 0;
+  for (const std::vector<int>* pixels : lists) total += pixels->size();
+  const size_t stride = std::max<size_t>(1, total / most);
   std::vector<int> sample;
-  const size_t stride = std::max<size_t>(1, pixels.size() / most);
-  for (size_t k = 0; k < pixels.size(); k += stride)
-    if (valid_point(pts[pixels[k]])) sample.push_back(pixels[k]);
+  sample.reserve(total / stride + 1);
+  size_t k = 0;  // the next index to visit, counted from the start of the current list
+  for (const std::vector<int>* pixels : lists) {
+    for (; k < pixels->size(); k += stride)
+      if (valid_point(pts[(*pixels)[k]])) sample.push_back((*pixels)[k]);
+    k -= pixels->size();
+  }
   return sample;
 }
+
+std::vector<int> sample_of(const std::vector<int>& pixels, const cv::Vec3f* pts, size_t most) {
+  const std::vector<int>* one[] = {&pixels};
+  return sample_of(one, pts, most);
+}
+
+// Sums for a least-squares plane: the points and their outer products, of which only the six distinct
+// entries are summed (the matrix is symmetric: the other three would repeat the same products).
+struct PlaneFit {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  long n = 0;
+  void add(const Eigen::Vector3f& point) {
+    const Eigen::Vector3d q = point.cast<double>();
+    sum += q;
+    xx += q.x() * q.x(); xy += q.x() * q.y(); xz += q.x() * q.z();
+    yy += q.y() * q.y(); yz += q.y() * q.z(); zz += q.z() * q.z();
+    ++n;
+  }
+  // The plane through the mean, normal along the axis of least variance, facing the camera; false for
+  // fewer than 10 points or points along a line.
+  bool plane(Plane& plane) const {
+    if (n < 10) return false;
+    const Eigen::Vector3d mean = sum / static_cast<double>(n);
+    Eigen::Matrix3d outer;
+    outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / static_cast<double>(n) - mean * mean.transpose());
+    if (eig.eigenvalues()(1) < 1e-8) return false;
+    Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    if (normal.dot(mean) > 0) normal = -normal;
+    plane.normal = normal.cast<float>();
+    plane.offset = static_cast<float>(-normal.dot(mean));
+    return true;
+  }
+};
 
 // Dominant plane of a patch: RANSAC over a sample of its points (a table patch may hold the foot of an
 // object that the edges did not separate), refined by least squares on the inliers. The band grows with
@@ -207,39 +251,28 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
 bool refit(const std::vector<Patch>& patches, const std::vector<int>& table, const cv::Mat& points, double band,
            Plane& plane) {
   const auto* pts = points.ptr<cv::Vec3f>();
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  long n = 0;
+  PlaneFit fit;
   for (int p : table)
     for (int i : sample_of(patches[static_cast<size_t>(p)].pixels, pts, 3000)) {
       const Eigen::Vector3f q = point_at(pts, i);
-      if (std::abs(plane.distance(q)) > plane_tolerance(band, q.z())) continue;
-      const Eigen::Vector3d d = q.cast<double>();
-      sum += d;
-      outer += d * d.transpose();
-      ++n;
+      if (std::abs(plane.distance(q)) <= plane_tolerance(band, q.z())) fit.add(q);
     }
-  if (n < 10) return false;
-  const Eigen::Vector3d mean = sum / static_cast<double>(n);
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / static_cast<double>(n) - mean * mean.transpose());
-  if (eig.eigenvalues()(1) < 1e-8) return false;
-  Eigen::Vector3d normal = eig.eigenvectors().col(0);
-  if (normal.dot(mean) > 0) normal = -normal;
-  plane.normal = normal.cast<float>();
-  plane.offset = static_cast<float>(-normal.dot(mean));
-  return true;
+  return fit.plane(plane);
 }
 
-// The patches a plane's refit is made from: normal close to the plane's, half of the points within the
+// A patch a plane's refit is made from: normal close to the plane's, half of the points within the
 // tolerance (a patch that holds an object's foot still counts).
+bool is_near(const Patch& patch, const cv::Mat& points, const Plane& plane, const Params::Support& params) {
+  const float min_cos = static_cast<float>(std::cos(params.table_angle_deg * M_PI / 180.0));
+  return patch.mean_normal.dot(plane.normal) >= min_cos && mostly_within(patch.pixels, points, plane, params.plane_band, 0.5);
+}
+
+// The patches that are is_near the plane.
 std::vector<int> patches_near(const std::vector<Patch>& patches, const cv::Mat& points, const Plane& plane,
                               const Params::Support& params) {
-  const float min_cos = static_cast<float>(std::cos(params.table_angle_deg * M_PI / 180.0));
   std::vector<int> near;
   for (size_t p = 0; p < patches.size(); ++p)
-    if (patches[p].mean_normal.dot(plane.normal) >= min_cos &&
-        mostly_within(patches[p].pixels, points, plane, params.plane_band, 0.5))
-      near.push_back(static_cast<int>(p));
+    if (is_near(patches[p], points, plane, params)) near.push_back(static_cast<int>(p));
   return near;
 }
 
@@ -248,25 +281,10 @@ std::vector<int> patches_near(const std::vector<Patch>& patches, const cv::Mat& 
 bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& plane) {
   const auto* pts = points.ptr<cv::Vec3f>();
   const size_t stride = std::max<size_t>(1, pixels.size() / 3000);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  int n = 0;
-  for (size_t k = 0; k < pixels.size(); k += stride) {
-    if (!valid_point(pts[pixels[k]])) continue;
-    const Eigen::Vector3d q = point_at(pts, pixels[k]).cast<double>();
-    sum += q;
-    outer += q * q.transpose();
-    ++n;
-  }
-  if (n < 10) return false;
-  const Eigen::Vector3d mean = sum / n;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / n - mean * mean.transpose());
-  if (eig.eigenvalues()(1) < 1e-8) return false;
-  Eigen::Vector3d normal = eig.eigenvectors().col(0);
-  if (normal.dot(mean) > 0) normal = -normal;
-  plane.normal = normal.cast<float>();
-  plane.offset = static_cast<float>(-normal.dot(mean));
-  return true;
+  PlaneFit fit;
+  for (size_t k = 0; k < pixels.size(); k += stride)
+    if (valid_point(pts[pixels[k]])) fit.add(point_at(pts, pixels[k]));
+  return fit.plane(plane);
 }
 
 bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double band,
@@ -275,26 +293,40 @@ bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const 
   const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
   const size_t visits = (pixels.size() + stride - 1) / stride;
   int in = 0, n = 0;
-  for (size_t v = 0; v < visits; ++v) {
-    const int i = pixels[v * stride];
-    if (!valid_point(pts[i])) continue;
-    ++n;
-    in += std::abs(plane.distance(point_at(pts, i))) <= plane_tolerance(band, pts[i][2]);
-    // Best final share (in + left) / (n + left); half a point of margin keeps rounding out of it.
-    const double left = static_cast<double>(visits - v - 1);
+  // Checked every kBlock visits: once the best final share (in + left) / (n + left) is below `share` it
+  // stays below (each visit lowers in + left - share * (n + left) or keeps it), so a later check gives
+  // the same answer with a cheaper loop. Half a point of margin keeps rounding out of it.
+  constexpr size_t kBlock = 16;
+  for (size_t block = 0; block < visits; block += kBlock) {
+    const size_t block_end = std::min(visits, block + kBlock);
+    for (size_t v = block; v < block_end; ++v) {
+      const int i = pixels[v * stride];
+      if (!valid_point(pts[i])) continue;
+      ++n;
+      in += std::abs(plane.distance(point_at(pts, i))) <= plane_tolerance(band, pts[i][2]);
+    }
+    const double left = static_cast<double>(visits - block_end);
     if (in + left < share * (n + left) - 0.5) return false;
   }
   return n && static_cast<double>(in) / n >= share;
 }
 
-PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin) {
+namespace {
+
+// Points a region is made from, at most about (the hull of a sample is the region's outline to within
+// the sample's spacing, a few millimetres).
+constexpr size_t kRegionSample = 4000;
+
+// The region of `sample` (valid pixels) in `plane`, grown by `margin` [m].
+PlaneRegion region_of_sample(const Plane& plane, const std::vector<int>& sample, const cv::Mat& points, double margin) {
   PlaneRegion r;
   r.plane = plane;
   r.u = plane.normal.unitOrthogonal();
   r.v = plane.normal.cross(r.u);
   const auto* pts = points.ptr<cv::Vec3f>();
   std::vector<cv::Point2f> projected;
-  for (int i : sample_of(pixels, pts, 4000)) {
+  projected.reserve(sample.size());
+  for (int i : sample) {
     const Eigen::Vector3f q = point_at(pts, i);
     projected.emplace_back(r.u.dot(q), r.v.dot(q));
   }
@@ -321,6 +353,12 @@ PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const 
   cv::fillConvexPoly(r.cells, poly, cv::Scalar(255));
   if (pad > 1) r.cells = dilate_by_spans(r.cells, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * pad - 1, 2 * pad - 1}));
   return r;
+}
+
+}  // namespace
+
+PlaneRegion region_of(const Plane& plane, const std::vector<int>& pixels, const cv::Mat& points, double margin) {
+  return region_of_sample(plane, sample_of(pixels, points.ptr<cv::Vec3f>(), kRegionSample), points, margin);
 }
 
 Eigen::Vector3f up_in_camera(const Camera& camera) {
@@ -429,9 +467,9 @@ void separate_marked(cv::Mat& edges, const cv::Mat& mark_image, const cv::Mat& p
   uchar* edge = edges.ptr<uchar>();
   const int width = patch_labels.cols, height = patch_labels.rows;
   for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
+    // Marked pixels are few: the rest of a row is skipped eight at a time.
+    for (int x = first_nonzero(mark + y * width, 0, width); x < width; x = first_nonzero(mark + y * width, x + 1, width)) {
       const int i = y * width + x;
-      if (!mark[i]) continue;
       const int neighbours[4] = {x > 0 ? i - 1 : -1, x + 1 < width ? i + 1 : -1, y > 0 ? i - width : -1,
                                  y + 1 < height ? i + width : -1};
       for (int j : neighbours)
@@ -460,12 +498,32 @@ std::vector<int> off_plane(const std::vector<int>& pixels, const cv::Vec3f* pts,
 
 namespace {
 
-// above[i] = 255 where point i (interleaved xyz) is valid and higher above the plane than k * max(1, z^2).
-CLUTTERSEG_ROW_KERNEL void mark_above_plane(const float* __restrict xyz, int n, float a, float b, float c, float d,
-                                            float k, uchar* __restrict above) {
+// above[i] = 255 where point i (interleaved xyz) is valid and higher above the plane than k * max(1, z^2);
+// returns how many are.
+CLUTTERSEG_ROW_KERNEL int mark_above_plane(const float* __restrict xyz, int n, float a, float b, float c, float d,
+                                           float k, uchar* __restrict above) {
+  int count = 0;
   for (int i = 0; i < n; ++i) {
     const float x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
-    above[i] = valid_depth(z) & (a * x + b * y + c * z + d > k * std::max(1.f, z * z)) ? 255 : 0;
+    const bool is_above = valid_depth(z) & (a * x + b * y + c * z + d > k * std::max(1.f, z * z));
+    above[i] = is_above ? 255 : 0;
+    count += is_above;
+  }
+  return count;
+}
+
+// Calls visit(first, count) for each run of consecutive indices in `pixels` (increasing, as a patch's
+// pixels are: its row segments). Strictly increasing indices 8 apart in value and in position have no
+// gap between them, so a run is crossed eight at a time.
+template <class Visit>
+void for_each_pixel_run(const std::vector<int>& pixels, Visit visit) {
+  const size_t n = pixels.size();
+  for (size_t begin = 0; begin < n;) {
+    size_t end = begin + 1;
+    while (end + 8 <= n && pixels[end + 7] - pixels[end - 1] == 8) end += 8;
+    while (end < n && pixels[end] == pixels[end - 1] + 1) ++end;
+    visit(pixels[begin], static_cast<int>(end - begin));
+    begin = end;
   }
 }
 
@@ -473,20 +531,31 @@ CLUTTERSEG_ROW_KERNEL void mark_above_plane(const float* __restrict xyz, int n, 
 
 int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                   const Plane& plane, const Params::Support& params, int min_px) {
-  // Every pixel's height once, in one vectorised pass; then the table patches' pixels are looked up.
-  cv::Mat above(patch_labels.size(), CV_8U);
-  mark_above_plane(points.ptr<float>(), static_cast<int>(points.total()), plane.normal.x(), plane.normal.y(),
-                   plane.normal.z(), plane.offset, static_cast<float>(params.plane_band), above.ptr<uchar>());
-  const uchar* is_above = above.ptr<uchar>();
-  cv::Mat clear(patch_labels.size(), CV_8U, cv::Scalar(0));  // core pixels of table patches clear of the plane
-  uchar* mark = clear.ptr<uchar>();
+  // Heights of the table patches' pixels only, run by run (vectorised), counted into a row-sized scratch
+  // line; the mark image is made only for a patch to cut (most frames have none).
+  const auto* xyz = points.ptr<float>();
+  std::array<uchar, 1024> scratch;  // marks of a piece of a run when only counting
+  // Pixels of `pixels` clear of the plane, marked in `image` (nullptr: counted only). Runs go in pieces
+  // that fit the scratch line (a run crosses rows where a patch spans them).
+  const auto above = [&](const std::vector<int>& pixels, uchar* image) {
+    int count = 0;
+    constexpr int kPiece = static_cast<int>(scratch.size());
+    for_each_pixel_run(pixels, [&](int first, int n) {
+      for (int begin = first; begin < first + n; begin += kPiece)
+        count += mark_above_plane(xyz + 3 * static_cast<size_t>(begin), std::min(kPiece, first + n - begin),
+                                  plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset,
+                                  static_cast<float>(params.plane_band), image ? image + begin : scratch.data());
+    });
+    return count;
+  };
+  cv::Mat clear;  // core pixels of table patches clear of the plane
   int cut = 0;
   for (const int p : patches_near(patches, points, plane, params)) {
     const auto& pixels = patches[static_cast<size_t>(p)].pixels;
-    int count = 0;
-    for (int i : pixels) count += is_above[i] != 0;
+    const int count = above(pixels, nullptr);
     if (count < min_px) continue;
-    for (int i : pixels) mark[i] = is_above[i];
+    if (clear.empty()) clear = cv::Mat(patch_labels.size(), CV_8U, cv::Scalar(0));
+    above(pixels, clear.ptr<uchar>());
     cut += count;
   }
   if (cut > 0) separate_marked(edges, clear, patch_labels);
@@ -496,24 +565,32 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
 int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                     double band, int min_px, const std::optional<Plane>& table, const Params::Support& support) {
   const auto* pts = points.ptr<cv::Vec3f>();
-  cv::Mat off(patch_labels.size(), CV_8U, cv::Scalar(0));  // pixels of flat patches off their dominant plane
-  uchar* mark = off.ptr<uchar>();
-  const std::vector<int> near_table = table ? patches_near(patches, points, *table, support) : std::vector<int>{};
+  cv::Mat off;  // pixels of flat patches off their dominant plane; made for the first patch to split
   int cut = 0;
-  for (size_t p = 0; p < patches.size(); ++p) {
-    const Patch& patch = patches[p];
+  for (const Patch& patch : patches) {
     if (patch.curved || static_cast<int>(patch.pixels.size()) < 2 * min_px) continue;  // a plane to split at
-    if (std::binary_search(near_table.begin(), near_table.end(), static_cast<int>(p))) continue;  // cut_off_table's
+    if (table && is_near(patch, points, *table, support)) continue;  // cut_off_table splits it at the table
     Plane plane;
     if (dominant_plane(patch.pixels, points, band, plane) < 0.6) continue;
     const std::vector<int> outside = off_plane(patch.pixels, pts, plane, band);
     if (static_cast<int>(outside.size()) < min_px) continue;
-    for (int i : outside) mark[i] = 255;
+    if (off.empty()) off = cv::Mat(patch_labels.size(), CV_8U, cv::Scalar(0));
+    for (int i : outside) off.ptr<uchar>()[i] = 255;
     cut += static_cast<int>(outside.size());
   }
   if (cut > 0) separate_marked(edges, off, patch_labels);
   return cut;
 }
+
+namespace {
+
+// differs[i] = 1 where a[i] != b[i].
+CLUTTERSEG_ROW_KERNEL void mark_differing(const int* __restrict a, const int* __restrict b, int n,
+                                          std::uint8_t* __restrict differs) {
+  for (int i = 0; i < n; ++i) differs[i] = a[i] != b[i];
+}
+
+}  // namespace
 
 int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, const std::vector<Patch>& patches,
                        const cv::Mat& points, const Plane& plane, const Params::Support& params) {
@@ -525,17 +602,15 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
   const auto k = static_cast<float>(params.pixel_band);
   std::vector<std::uint8_t> table(static_cast<size_t>(num_patches) + 1, 0);
   for (int p = 0; p < num_patches; ++p) table[static_cast<size_t>(p) + 1] = patches[static_cast<size_t>(p)].table;
+  // Only edge pixels can be released: those whose label differs from the core label, marked in a
+  // vectorised pass and then visited eight bytes at a time.
+  cv::Mat differs_image(assigned_labels.size(), CV_8U);  // every byte written: no zeroing
+  std::uint8_t* differs = differs_image.ptr<std::uint8_t>();
+  mark_differing(lab, core, total, differs);
   int released = 0;
-  // Only edge pixels can be released: 32 labels at a time are compared with the core labels (memcmp),
-  // and the pixels of a block that differs are looked at.
-  constexpr int kBlock = 32;
-  for (int i = 0; i < total; ++i) {
-    if (i % kBlock == 0 && i + kBlock <= total && std::memcmp(lab + i, core + i, kBlock * sizeof(int)) == 0) {
-      i += kBlock - 1;
-      continue;
-    }
+  for (int i = first_nonzero(differs, 0, total); i < total; i = first_nonzero(differs, i + 1, total)) {
     const int l = lab[i];
-    if (l == core[i] || l <= 0 || l > num_patches) continue;  // a core pixel, or no patch: not an edge pixel's
+    if (l <= 0 || l > num_patches) continue;  // no patch
     const float x = pts[i][0], y = pts[i][1], z = pts[i][2];
     if (!table[static_cast<size_t>(l)] || a * x + b * y + c * z + d <= k * std::max(1.f, z * z)) continue;
     lab[i] = 0;
@@ -607,10 +682,11 @@ int settle_table(std::vector<Patch>& patches, const std::vector<std::pair<int, i
 
 Support support_of(const Plane& plane, const std::vector<Patch>& patches, const cv::Mat& points,
                    const Params::Support& params) {
-  std::vector<int> table_pixels;
+  std::vector<const std::vector<int>*> table_pixels;
   for (const auto& patch : patches)
-    if (patch.table) table_pixels.insert(table_pixels.end(), patch.pixels.begin(), patch.pixels.end());
-  return {plane, region_of(plane, table_pixels, points, params.region_margin)};
+    if (patch.table) table_pixels.push_back(&patch.pixels);
+  const std::vector<int> sample = sample_of(table_pixels, points.ptr<cv::Vec3f>(), kRegionSample);
+  return {plane, region_of_sample(plane, sample, points, params.region_margin)};
 }
 
 }  // namespace clutterseg
