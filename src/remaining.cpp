@@ -27,7 +27,6 @@
 //   nearby pixels is deterministic and does not need RANSAC's random draws.
 #include "clutterseg/remaining.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -96,30 +95,15 @@ constexpr int kMaxVisits = 4000;
 bool fit_local_plane(const cv::Mat& labels, const cv::Mat& points, int patch, cv::Rect window, Plane& plane,
                      Eigen::Vector3f& centroid) {
   const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  int n = 0;
+  PlaneFit fit;
   for (int y = window.y; y < window.y + window.height; y += stride) {
     const int* lab = labels.ptr<int>(y);
     const auto* pts = points.ptr<cv::Vec3f>(y);
-    for (int x = window.x; x < window.x + window.width; x += stride) {
-      if (lab[x] != patch || !valid_point(pts[x])) continue;
-      const Eigen::Vector3d q(pts[x][0], pts[x][1], pts[x][2]);
-      sum += q;
-      outer += q * q.transpose();
-      ++n;
-    }
+    for (int x = window.x; x < window.x + window.width; x += stride)
+      if (lab[x] == patch && valid_point(pts[x])) fit.add({pts[x][0], pts[x][1], pts[x][2]});
   }
-  if (n < 10) return false;
-  const Eigen::Vector3d mean = sum / n;
-  const Eigen::Matrix3d cov = outer / n - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  if (eig.eigenvalues()(1) < 1e-8) return false;  // a line of points (spread below 0.1 mm across)
-  Eigen::Vector3d normal = eig.eigenvectors().col(0);
-  if (normal.dot(mean) > 0) normal = -normal;  // facing the camera
-  plane.normal = normal.cast<float>();
-  plane.offset = static_cast<float>(-normal.dot(mean));
-  centroid = mean.cast<float>();
+  if (!fit.plane(plane)) return false;
+  centroid = fit.mean();
   return true;
 }
 

@@ -164,36 +164,6 @@ std::vector<int> sample_of(const std::vector<int>& pixels, const cv::Vec3f* pts,
   return sample_of(one, pts, most);
 }
 
-// Sums for a least-squares plane: the points and their outer products, of which only the six distinct
-// entries are summed (the matrix is symmetric: the other three would repeat the same products).
-struct PlaneFit {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-  long n = 0;
-  void add(const Eigen::Vector3f& point) {
-    const Eigen::Vector3d q = point.cast<double>();
-    sum += q;
-    xx += q.x() * q.x(); xy += q.x() * q.y(); xz += q.x() * q.z();
-    yy += q.y() * q.y(); yz += q.y() * q.z(); zz += q.z() * q.z();
-    ++n;
-  }
-  // The plane through the mean, normal along the axis of least variance, facing the camera; false for
-  // fewer than 10 points or points along a line.
-  bool plane(Plane& plane) const {
-    if (n < 10) return false;
-    const Eigen::Vector3d mean = sum / static_cast<double>(n);
-    Eigen::Matrix3d outer;
-    outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / static_cast<double>(n) - mean * mean.transpose());
-    if (eig.eigenvalues()(1) < 1e-8) return false;
-    Eigen::Vector3d normal = eig.eigenvectors().col(0);
-    if (normal.dot(mean) > 0) normal = -normal;
-    plane.normal = normal.cast<float>();
-    plane.offset = static_cast<float>(-normal.dot(mean));
-    return true;
-  }
-};
-
 // Dominant plane of a patch: RANSAC over a sample of its points (a table patch may hold the foot of an
 // object that the edges did not separate), refined by least squares on the inliers. The band grows with
 // the patch's depth (plane_tolerance). Deterministic: the draws are seeded by the patch size. Returns the
@@ -277,6 +247,20 @@ std::vector<int> patches_near(const std::vector<Patch>& patches, const cv::Mat& 
 }
 
 }  // namespace
+
+bool PlaneFit::plane(Plane& plane) const {
+  if (n < 10) return false;
+  const Eigen::Vector3d mean = sum / static_cast<double>(n);
+  Eigen::Matrix3d outer;
+  outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / static_cast<double>(n) - mean * mean.transpose());
+  if (eig.eigenvalues()(1) < 1e-8) return false;  // a line of points (spread below 0.1 mm across)
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  if (normal.dot(mean) > 0) normal = -normal;  // facing the camera
+  plane.normal = normal.cast<float>();
+  plane.offset = static_cast<float>(-normal.dot(mean));
+  return true;
+}
 
 bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& plane) {
   const auto* pts = points.ptr<cv::Vec3f>();

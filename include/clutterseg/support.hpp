@@ -40,6 +40,25 @@ struct Support {
 // the band is as given.
 inline float plane_tolerance(double band, float z) { return static_cast<float>(band) * std::max(1.f, z * z); }
 
+// Sums for a least-squares plane: the points and the six distinct entries of their outer products (the
+// matrix is symmetric; the other three would repeat the same products).
+struct PlaneFit {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  long n = 0;
+  void add(const Eigen::Vector3f& point) {
+    const Eigen::Vector3d q = point.cast<double>();
+    sum += q;
+    xx += q.x() * q.x(); xy += q.x() * q.y(); xz += q.x() * q.z();
+    yy += q.y() * q.y(); yz += q.y() * q.z(); zz += q.z() * q.z();
+    ++n;
+  }
+  Eigen::Vector3f mean() const { return (sum / static_cast<double>(n)).cast<float>(); }
+  // The plane through the mean, normal along the axis of least variance, facing the camera; false for
+  // fewer than 10 points or points along a line.
+  bool plane(Plane& plane) const;
+};
+
 // Least-squares plane of the valid points of `pixels` (at most ~3000 read), normal facing the camera.
 bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& plane);
 
