@@ -209,9 +209,12 @@ double dominant_plane(const std::vector<int>& pixels, const cv::Mat& points, dou
     if (std::abs(best.distance(point_at(pts, sample[k]))) <= tolerance[k]) inliers.push_back(sample[k]);
   plane = best;
   Plane refined;
-  if (fit_plane(inliers, points, refined) && inliers_of(refined) >= best_count) {
-    plane = refined;
-    return static_cast<double>(inliers_of(refined)) / static_cast<double>(sample.size());
+  if (fit_plane(inliers, points, refined)) {
+    const int count = inliers_of(refined);
+    if (count >= best_count) {
+      plane = refined;
+      return static_cast<double>(count) / static_cast<double>(sample.size());
+    }
   }
   return static_cast<double>(best_count) / static_cast<double>(sample.size());
 }
@@ -383,17 +386,14 @@ std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const
 
   // Score: pixels of the other patches (a sample of each) standing on the candidate: above it by more than
   // the tolerance and at most max_height, over its visible region. Other large planes do not count, so a
-  // wall does not score the table in front of it, nor the floor below it.
-  std::vector<std::vector<int>> samples(patches.size());
-  for (size_t p = 0; p < patches.size(); ++p) samples[p] = sample_of(patches[p].pixels, pts, 500);
-  int best = -1;
-  double best_score = -1;
-  for (size_t k = 0; k < candidates.size(); ++k) {
-    const Plane& plane = planes[k];
-    const PlaneRegion region = region_of(plane, patches[static_cast<size_t>(candidates[k])].pixels, points, params.region_margin);
+  // wall does not score the table in front of it, nor the floor below it. Without the region test
+  // (`region` null) the score is an upper bound: more points count, and the lowest point is lower; it
+  // is only needed up to where it passes `enough`.
+  std::vector<std::vector<int>> samples(patches.size());  // empty for the large planes
+  auto score_of = [&](const Plane& plane, const PlaneRegion* region, double enough) {
     double score = 0;
-    for (size_t p = 0; p < patches.size(); ++p) {
-      if (std::find(large_planes.begin(), large_planes.end(), static_cast<int>(p)) != large_planes.end() || samples[p].empty()) continue;
+    for (size_t p = 0; p < patches.size() && score <= enough; ++p) {
+      if (samples[p].empty()) continue;
       // A patch rests on the plane when its lowest point over the region is within contact_distance (a
       // box in front of a wall floats 20 cm off it; a box's side faces reach down to the table it stands on).
       int standing = 0;
@@ -401,14 +401,31 @@ std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const
       for (int i : samples[p]) {
         const Eigen::Vector3f q = point_at(pts, i);
         const float h = plane.distance(q);
-        if (h <= -plane_tolerance(params.plane_band, q.z()) || h > params.max_height || !region.over(q)) continue;
+        if (h <= -plane_tolerance(params.plane_band, q.z()) || h > params.max_height || (region && !region->over(q))) continue;
         lowest = std::min(lowest, h);
         standing += h > plane_tolerance(params.plane_band, q.z());
       }
       if (lowest > params.contact_distance) continue;
       score += static_cast<double>(standing) / static_cast<double>(samples[p].size()) * static_cast<double>(patches[p].pixels.size());
     }
-    if (score > best_score) { best_score = score; best = static_cast<int>(k); }
+    return score;
+  };
+  // The best score, ties to the lower index. The region (most of the cost) is built only for a candidate
+  // whose bound can beat the best so far; the largest candidate comes first, and is mostly the table.
+  // One candidate needs no score.
+  int best = 0;
+  if (candidates.size() > 1) {
+    for (size_t p = 0; p < patches.size(); ++p)
+      if (std::find(large_planes.begin(), large_planes.end(), static_cast<int>(p)) == large_planes.end())
+        samples[p] = sample_of(patches[p].pixels, pts, 500);
+    constexpr double kAll = std::numeric_limits<double>::infinity();
+    double best_score = -1;
+    for (size_t k = 0; k < candidates.size(); ++k) {
+      if (k > 0 && score_of(planes[k], nullptr, best_score) <= best_score) continue;
+      const PlaneRegion region = region_of(planes[k], patches[static_cast<size_t>(candidates[k])].pixels, points, params.region_margin);
+      const double score = score_of(planes[k], &region, kAll);
+      if (score > best_score) { best_score = score; best = static_cast<int>(k); }
+    }
   }
   // Refit over every patch lying in the plane, twice: the second pass sees the pieces the first one's
   // better plane brings within the tolerance.
