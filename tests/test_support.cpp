@@ -35,6 +35,21 @@ TEST(Support, TheTableNotTheWallAndNotAPlaneFacingDown) {
   }
 }
 
+TEST(Support, TheTableNotTheLargerFloorBelowIt) {
+  // A small table 30 cm above a floor that fills most of the image: the floor is the largest plane (the
+  // first candidate), but the boxes stand on the table. The table must win even though its region is
+  // built only because its bound can beat the floor's score.
+  Shape floor = table(1.5);
+  floor.pose = Eigen::Translation3d(0, 0, -0.3);
+  TestScene scene{{{floor, table(0.15), box(1, {-0.05, 0, 0.05}, {0.05, 0.04, 0.05}), box(2, {0.07, 0.02, 0.04}, {0.03, 0.03, 0.04})}}};
+  const Segmented s = segment_scene(scene);
+  ASSERT_TRUE(s.result.support_plane);
+  const Eigen::Vector3f table_centre = (scene.world_to_camera * Eigen::Vector3d::Zero()).cast<float>();
+  const Eigen::Vector3f floor_point = (scene.world_to_camera * Eigen::Vector3d(0, 0, -0.3)).cast<float>();
+  EXPECT_LT(std::abs(s.result.support_plane->distance(table_centre)), 0.01f);
+  EXPECT_GT(std::abs(s.result.support_plane->distance(floor_point)), 0.2f);
+}
+
 TEST(Support, APatchOfTwoParallelTopsIsSplitAtItsPlane) {
   // A box and a smaller one beside it, their tops 2 cm apart in height; one patch holding both tops, as
   // if the edges had a gap between them.
