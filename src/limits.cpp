@@ -77,6 +77,7 @@ void validate(const Params& p) {
   int_range("remaining.hole_px", p.remaining.hole_px, 0, 1000);
   in_range("remaining.shadow_baseline", p.remaining.shadow_baseline, -1, 1);
   in_range("remaining.occluded_jump", p.remaining.occluded_jump, 0, 1);
+  in_range("remaining.hidden_coplanar_band", p.remaining.hidden_coplanar_band, 0, 1);
   above("support.plane_band", p.support.plane_band, 0, 1);
   in_range("support.pixel_band", p.support.pixel_band, 0, 1);
   in_range("support.table_angle_deg", p.support.table_angle_deg, 0, 90);

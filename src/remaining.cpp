@@ -20,6 +20,9 @@
 // - Beyond the paper: a table face (TableHint) takes no pixel standing clear of the table's plane.
 // - Beyond the paper: in rules 2-3 a segment seen behind its one face across depth jumps (most of its
 //   contacts with it, Params::Remaining::occluded_jump) is an object that face hides, not a part of it.
+// - Beyond the paper: in rules 1-3 a segment that would be an object of its own (hidden behind its one face,
+//   or cut off from every face by missing depth) joins the object on whose nearby faces' planes it lies, with
+//   only nearer things between (the co-planarity cue f/g for a segment; Params::Remaining::hidden_coplanar_band).
 // - Rule 5 is otherwise decided per pixel, not per segment: the remaining pixels between two objects are mostly
 //   a bold edge band that belongs half to each, and boundaries decide the metrics. The plane of each
 //   neighbouring face is a least-squares fit to that face's pixels near the segment (local, so a
@@ -33,6 +36,7 @@
 #include <limits>
 #include <span>
 
+#include "clutterseg/occlusion.hpp"
 #include "clutterseg/parallel.hpp"
 #include "clutterseg/support.hpp"
 
@@ -45,6 +49,14 @@ namespace {
 // contacts of a cylinder's top with its side (mixed-000004: 7 of 127 ring pixels) keep the top with the side.
 constexpr int kHiddenRatio = 4;
 constexpr double kHiddenRingShare = 0.06;
+// A hidden segment joins a face of another object when this share of its points lies on that face's plane;
+// at most this many faces near it are fitted.
+constexpr double kCoplanarShare = 0.8;
+constexpr size_t kCoplanarCandidates = 6;
+// The occlusion check between them: a sample behind the 3D segment by more than kBehindTolerance is a gap
+// (background seen between), and more than kBehindFraction of such samples fail it (co-planarity's defaults).
+constexpr double kBehindTolerance = 0.01;
+constexpr double kBehindFraction = 0.05;
 
 struct Segment {
   size_t begin, end;  // its pixels in the list of all segments' pixels
@@ -124,7 +136,8 @@ bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, con
 
 cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
                          int num_objects, const cv::Mat& points, const NormalPlanes& normals,
-                         const Params::Remaining& params, int tiny_px, const std::optional<TableHint>& table) {
+                         const Params::Remaining& params, int tiny_px, const std::optional<TableHint>& table,
+                         const Camera* camera) {
   if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || assigned_labels.size() != points.size())
     throw Error("assign_remaining: labels must be CV_32S and points CV_32FC3 of the same size");
   const bool have_normals = !normals[0].empty();
@@ -208,6 +221,63 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   const auto clear_of_table = [&](const cv::Vec3f& q) {
     return table && table->plane.distance({q[0], q[1], q[2]}) > plane_tolerance(table->pixel_band, q[2]);
   };
+  // Beyond the paper: the object (id), not the occluder's (`occluder`), whose faces near a segment cut off
+  // by an occluder hold at least kCoplanarShare of the segment's points on their local planes
+  // (plane_tolerance(hidden_coplanar_band, z); a segment may hold a box's top and front, so a point counts
+  // when it lies on any face of that object), with nothing behind the line between the segment and each
+  // such face (co-planarity's occlusion check, g); 0 if none. The faces looked for are those in the
+  // segment's box grown by twice its size on every side (an occluder twice as wide as the segment), read
+  // with a stride (at most about kMaxVisits pixels); at most kCoplanarCandidates of them are fitted.
+  std::vector<uchar> on_face;  // per segment pixel: on a face of the object looked at
+  const auto coplanar_object = [&](std::span<const int> seg_pixels, const cv::Rect& bbox, int occluder) {
+    const auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
+    if (!camera) return 0;
+    Eigen::Vector3f own_centroid = Eigen::Vector3f::Zero();
+    for (int i : seg_pixels) own_centroid += Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
+    own_centroid /= static_cast<float>(seg_pixels.size());
+    const int margin = 2 * std::max(bbox.width, bbox.height);
+    const cv::Rect window = cv::Rect(bbox.x - margin, bbox.y - margin, bbox.width + 2 * margin, bbox.height + 2 * margin) &
+                            cv::Rect(0, 0, width, height);
+    const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
+    std::vector<std::pair<int, int>> seen;  // (visits, patch label)
+    for (int y = window.y; y < window.y + window.height; y += stride)
+      for (int x = window.x; x < window.x + window.width; x += stride) {
+        const int l = lab[y * width + x];
+        if (l <= 0 || is_table(l) || object_of(l) == occluder) continue;
+        auto it = std::find_if(seen.begin(), seen.end(), [&](const auto& v) { return v.second == l; });
+        if (it == seen.end()) seen.emplace_back(1, l); else ++it->first;
+      }
+    std::sort(seen.begin(), seen.end(), [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
+    if (seen.size() > kCoplanarCandidates) seen.resize(kCoplanarCandidates);
+    // The faces that pass the occlusion check, with their planes, grouped by object below.
+    std::vector<std::pair<int, Plane>> faces_near;  // (object id, local plane)
+    for (const auto& [visits, l] : seen) {
+      Plane plane;
+      Eigen::Vector3f centroid;
+      if (!fit_plane_near(assigned_labels, points, l, bbox, plane, centroid)) continue;
+      if (behind_fraction(own_centroid, centroid, points, *camera, kBehindTolerance) > kBehindFraction) continue;
+      faces_near.emplace_back(object_of(l), plane);
+    }
+    int best_object = 0;
+    double best_share = kCoplanarShare;
+    for (size_t f = 0; f < faces_near.size(); ++f) {
+      const int object = faces_near[f].first;
+      if (std::any_of(faces_near.begin(), faces_near.begin() + static_cast<std::ptrdiff_t>(f), [&](const auto& g) { return g.first == object; }))
+        continue;  // this object was counted with its first face
+      on_face.assign(seg_pixels.size(), 0);
+      for (size_t g = f; g < faces_near.size(); ++g) {
+        if (faces_near[g].first != object) continue;
+        const Plane& plane = faces_near[g].second;
+        for (size_t k = 0; k < seg_pixels.size(); ++k) {
+          const cv::Vec3f& q = pts[seg_pixels[k]];
+          on_face[k] |= std::abs(plane.distance({q[0], q[1], q[2]})) <= plane_tolerance(params.hidden_coplanar_band, q[2]);
+        }
+      }
+      const double share = static_cast<double>(std::count(on_face.begin(), on_face.end(), 1)) / static_cast<double>(seg_pixels.size());
+      if (share > best_share) { best_share = share; best_object = object; }
+    }
+    return best_object;
+  };
   for (size_t s = 0; s < segments.size(); ++s) {
     const Segment& seg = segments[s];
     const std::span<const int> seg_pixels(pixels.data() + seg.begin, seg.end - seg.begin);
@@ -261,7 +331,11 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
 
     if (faces.empty()) {                                              // rule 1
       // A tiny segment alone is sensor noise (stereo sensors leave thousands of them), not an object.
-      if (static_cast<int>(seg_pixels.size()) >= tiny_px) set_all(++next_object);
+      // Beyond the paper: cut off by missing depth (an occluder's shadow), it may be the far part of an object.
+      if (static_cast<int>(seg_pixels.size()) >= tiny_px) {
+        const int coplanar = params.hidden_coplanar_band > 0 ? coplanar_object(seg_pixels, seg.bbox, 0) : 0;
+        set_all(coplanar > 0 ? coplanar : ++next_object);
+      }
       continue;
     }
     if (faces.size() == 1) {
@@ -270,7 +344,10 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       // Beyond the paper: seen behind its one face across depth jumps (most of its contacts), the segment is
       // an object that face hides, not a part of it.
       const bool hidden = behind > kHiddenRatio * touching && behind >= kHiddenRingShare * static_cast<double>(ring.size());
-      set_all(!tiny && (enclosed || hidden) ? ++next_object : object_of(faces[0].first));
+      // Beyond the paper: hidden, it may be the far part of an object the face cuts in two (co-planarity, f/g).
+      const int coplanar = !tiny && hidden && params.hidden_coplanar_band > 0
+          ? coplanar_object(seg_pixels, seg.bbox, object_of(faces[0].first)) : 0;
+      set_all(coplanar > 0 ? coplanar : !tiny && (enclosed || hidden) ? ++next_object : object_of(faces[0].first));
       continue;
     }
     const int first_object = object_of(faces[0].first);

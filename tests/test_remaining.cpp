@@ -100,6 +100,41 @@ TEST(Remaining, ASegmentHiddenBehindItsOneFaceIsAnObjectOfItsOwn) {
   EXPECT_EQ(run(0.90f, 0.03), 1);  // in front of the face
 }
 
+// Beyond the paper (Params::Remaining::hidden_coplanar_band): a box behind a nearer one, cut in two by it.
+// Its right part is a face (object 2), its left part a segment with no patch (too small and too far for
+// one), hidden behind the occluder (object 1) or cut off from it by the occluder's shadow (no depth: rule 1).
+// On the plane of the right part, with only the occluder between them, it joins that object (the
+// co-planarity cue f/g for a segment); off that plane, or with the switch off, it stays an object of its own.
+TEST(Remaining, AHiddenSegmentOnTheFarPartsPlaneJoinsItAcrossTheOccluder) {
+  const auto run = [](float z, double band, bool shadow) {
+    Case c;
+    c.labels.setTo(1);                          // the occluder, 20 cm in front
+    c.depth.setTo(0.9f);
+    c.labels.colRange(20, 40).setTo(2);         // the far box's right part
+    c.depth.colRange(20, 40).setTo(1.1f);
+    if (shadow) {                               // no depth around the left part
+      c.labels(cv::Rect(0, 8, 10, 12)).setTo(0);
+      c.depth(cv::Rect(0, 8, 10, 12)).setTo(0);
+    }
+    c.labels(cv::Rect(0, 10, 8, 8)).setTo(0);   // the left part, at the image border
+    c.depth(cv::Rect(0, 10, 8, 8)).setTo(z);
+    Params::Remaining params;
+    params.hidden_coplanar_band = band;
+    Camera camera;
+    camera.fx = camera.fy = 525;
+    camera.cx = 20;
+    camera.cy = 15;
+    camera.width = 40;
+    camera.height = 30;
+    return assign_remaining(c.labels, {0, 1}, 2, c.points(), NormalPlanes{}, params, 20, {}, &camera).at<int>(14, 3);
+  };
+  for (const bool shadow : {false, true}) {
+    EXPECT_EQ(run(1.1f, 0.008, shadow), 2) << shadow;  // on the far part's plane: that object
+    EXPECT_EQ(run(1.1f, 0, shadow), 3) << shadow;      // off: an object of its own (occluded_jump; rule 1)
+    EXPECT_EQ(run(1.2f, 0.008, shadow), 3) << shadow;  // 10 cm behind the far part's plane: another object
+  }
+}
+
 TEST(Remaining, Rule4SeveralNeighboursOfOneObjectJoinIt) {
   Case c;  // patches 1 and 2 (both object 0) left and right of a band 3 cm in front
   c.labels.colRange(0, 18).setTo(1);

@@ -118,6 +118,11 @@ struct Params {
     double occluded_jump = 0.03; // beyond the paper: a segment whose only neighbouring face (rules 2-3) touches
                                  // it mostly across depth jumps larger than this, the segment behind, is an
                                  // object that face hides, not a part of it [m]; 0 = off (remaining.hpp)
+    double hidden_coplanar_band = 0.008;  // beyond the paper (the co-planarity cue f/g for a remaining segment):
+                                 // a segment hidden behind its face whose points lie within this of the
+                                 // plane of a flat face of another object near it joins that object, the
+                                 // far part of an object the occluder cuts in two [m at 1 m, times z^2
+                                 // beyond]; 0 = off (a new object, as occluded_jump alone)
   } remaining;
 
   // Beyond the paper: the support plane (table), decided per patch before the graph (support.hpp).
