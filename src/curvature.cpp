@@ -41,13 +41,15 @@ CLUTTERSEG_ROW_KERNEL void differs_from_neighbours(const int* __restrict up, con
 }
 
 // Per label (index id - 1, only where `wanted`), the pixels with an 8-neighbour outside the label:
-// one pass over the image. The two closest pixels of two disjoint patches are boundary pixels: from
-// an interior pixel, a step towards the other patch stays inside and gets closer.
-std::vector<std::vector<cv::Point>> boundaries(const cv::Mat& labels, const std::vector<char>& wanted) {
+// one pass over rows [y_begin, y_end), which must hold every wanted pixel. The two closest pixels of two
+// disjoint patches are boundary pixels: from an interior pixel, a step towards the other patch stays
+// inside and gets closer.
+std::vector<std::vector<cv::Point>> boundaries(const cv::Mat& labels, const std::vector<char>& wanted, int y_begin,
+                                               int y_end) {
   std::vector<std::vector<cv::Point>> out(wanted.size());
   const int max_id = static_cast<int>(wanted.size()), cols = labels.cols;
   std::vector<uchar> on_edge(static_cast<size_t>(cols), 1);  // image border pixels stay 1
-  for (int y = 0; y < labels.rows; ++y) {
+  for (int y = std::max(0, y_begin); y < std::min(labels.rows, y_end); ++y) {
     const int* row = labels.ptr<int>(y);
     const bool inner_row = y > 0 && y + 1 < labels.rows;
     if (inner_row) differs_from_neighbours(labels.ptr<int>(y - 1), row, labels.ptr<int>(y + 1), cols, on_edge.data());
@@ -275,13 +277,19 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   auto boundary_of = [&](int i) -> const std::vector<cv::Point>& {
     if (boundary_by_id.empty()) {
       std::vector<char> wanted;
+      int y_begin = assigned_labels.rows, y_end = 0;  // the rows of their boxes: only these hold their pixels
       for (const auto& [x, y] : similar)
         for (const int k : {x, y}) {
-          const int id = patches[static_cast<size_t>(k)].id;
+          const Patch& patch = patches[static_cast<size_t>(k)];
+          const int id = patch.id;
           if (id > static_cast<int>(wanted.size())) wanted.resize(static_cast<size_t>(id), 0);
-          if (id > 0) wanted[static_cast<size_t>(id - 1)] = 1;
+          if (id <= 0) continue;
+          wanted[static_cast<size_t>(id - 1)] = 1;
+          const cv::Rect box = box_of(patch);
+          y_begin = std::min(y_begin, box.y);
+          y_end = std::max(y_end, box.y + box.height);
         }
-      boundary_by_id = boundaries(assigned_labels, wanted);
+      boundary_by_id = boundaries(assigned_labels, wanted, y_begin, y_end);
     }
     return boundary_by_id[static_cast<size_t>(patches[static_cast<size_t>(i)].id - 1)];
   };

@@ -75,20 +75,23 @@ int next_remaining(const std::vector<uchar>& state, int from) {
 }
 
 // Object id of every pixel (obj) and the remaining pixels: no patch but a valid point (state =
-// kRemaining). Returns their count; *max_label = the largest label seen. Branch-free, one vectorised
-// pass (labels and depth are noisy at edges; the lookup is a gather).
-CLUTTERSEG_ROW_KERNEL int mark_remaining(const int* __restrict lab, const float* __restrict xyz,
-                                         const int* __restrict object_of_label, int total, int num_patches,
-                                         int* __restrict obj, uchar* __restrict state, int* __restrict max_label) {
+// kRemaining; `state` comes zeroed). Returns their count; *max_label = the largest label seen. Labels come
+// in long runs (a patch's row segments): one lookup and one fill per run, and the depth is read only in
+// runs of label 0 (edge bands and holes: a small share of the image).
+int mark_remaining(const int* __restrict lab, const float* __restrict xyz, const int* __restrict object_of_label,
+                   int total, int num_patches, int* __restrict obj, uchar* __restrict state, int* __restrict max_label) {
   int count = 0, largest = 0;
-  for (int i = 0; i < total; ++i) {
-    const int l = lab[i];
+  for (int begin = 0; begin < total;) {
+    const int l = lab[begin], end = run_end(lab, begin, total);
     largest = std::max(largest, l);
-    obj[i] = object_of_label[std::clamp(l, 0, num_patches)];  // out of range is reported by the caller
-    const float z = xyz[3 * i + 2];
-    const bool remaining = (l == 0) & valid_depth(z);
-    state[i] = remaining ? kRemaining : 0;
-    count += remaining;
+    std::fill(obj + begin, obj + end, object_of_label[std::clamp(l, 0, num_patches)]);  // out of range: the caller
+    if (l == 0)
+      for (int i = begin; i < end; ++i) {
+        const bool remaining = valid_depth(xyz[3 * i + 2]);
+        state[i] = remaining ? kRemaining : 0;
+        count += remaining;
+      }
+    begin = end;
   }
   *max_label = largest;
   return count;
@@ -183,17 +186,32 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const int i = pixels[head];
       const int x = i % width, y = i / width;
       x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
-      // Pixels two or more steps inside the image need no border test (most of them).
-      const bool inside = x >= 2 && y >= 2 && x + 2 < width && y + 2 < height;
-      for (int k = 0; k < 16; ++k) {
-        // The 8 neighbours, then the pixels two steps away across a neighbour without depth.
-        const int step = k < 8 ? 1 : 2;
-        int j = i + offset[k];
-        if (!inside) {
-          const int xx = x + step * kDx[k % 8], yy = y + step * kDy[k % 8];
-          if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
-          j = yy * width + xx;
+      // Pixels two or more steps inside the image need no border test (most of them): the 8 neighbours,
+      // then the pixels two steps away across a neighbour without depth, in the order of `offset`.
+      if (x >= 2 && y >= 2 && x + 2 < width && y + 2 < height) {
+        for (int k = 0; k < 8; ++k) {
+          const int j = i + offset[k];
+          if (state[static_cast<size_t>(j)] != kRemaining) continue;
+          const cv::Vec3f d = pts[i] - pts[j];
+          if (d.dot(d) >= grow2) continue;
+          state[static_cast<size_t>(j)] = kGrown;
+          pixels.push_back(j);
         }
+        for (int k = 8; k < 16; ++k) {
+          const int j = i + offset[k];
+          if (state[static_cast<size_t>(j)] != kRemaining || valid_point(pts[i + offset[k - 8]])) continue;
+          const cv::Vec3f d = pts[i] - pts[j];
+          if (d.dot(d) >= grow2 * 4.f) continue;
+          state[static_cast<size_t>(j)] = kGrown;
+          pixels.push_back(j);
+        }
+        continue;
+      }
+      for (int k = 0; k < 16; ++k) {
+        const int step = k < 8 ? 1 : 2;
+        const int xx = x + step * kDx[k % 8], yy = y + step * kDy[k % 8];
+        if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
+        const int j = yy * width + xx;
         if (state[static_cast<size_t>(j)] != kRemaining) continue;
         if (step == 2 && valid_point(pts[i + offset[k - 8]])) continue;
         const cv::Vec3f d = pts[i] - pts[j];
@@ -299,7 +317,9 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
           if (xx < 0 || yy < 0 || xx >= width || yy >= height) { touches_border = true; continue; }
           j = yy * width + xx;
         }
-        if (state[static_cast<size_t>(j)] == kInSegment || (state[static_cast<size_t>(j)] & kInRing)) continue;
+        // In the segment or in the ring already (kInSegment has no ring bit and is the only state above
+        // kGrown without it): one test for both.
+        if (state[static_cast<size_t>(j)] >= kInSegment) continue;
         state[static_cast<size_t>(j)] |= kInRing;
         ring.push_back(j);
         if (lab[j] > 0) {
