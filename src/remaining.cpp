@@ -186,38 +186,27 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const int i = pixels[head];
       const int x = i % width, y = i / width;
       x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
-      // Pixels two or more steps inside the image need no border test (most of them): the 8 neighbours,
-      // then the pixels two steps away across a neighbour without depth, in the order of `offset`.
+      // The 8 neighbours, then the pixels two steps away across a neighbour without depth, in the order of
+      // `offset`. Pixels two or more steps inside the image need no border test (most of them).
+      const auto grow = [&](int j, float limit2) {
+        if (state[static_cast<size_t>(j)] != kRemaining) return;
+        const cv::Vec3f d = pts[i] - pts[j];
+        if (d.dot(d) >= limit2) return;
+        state[static_cast<size_t>(j)] = kGrown;
+        pixels.push_back(j);
+      };
       if (x >= 2 && y >= 2 && x + 2 < width && y + 2 < height) {
-        for (int k = 0; k < 8; ++k) {
-          const int j = i + offset[k];
-          if (state[static_cast<size_t>(j)] != kRemaining) continue;
-          const cv::Vec3f d = pts[i] - pts[j];
-          if (d.dot(d) >= grow2) continue;
-          state[static_cast<size_t>(j)] = kGrown;
-          pixels.push_back(j);
-        }
-        for (int k = 8; k < 16; ++k) {
-          const int j = i + offset[k];
-          if (state[static_cast<size_t>(j)] != kRemaining || valid_point(pts[i + offset[k - 8]])) continue;
-          const cv::Vec3f d = pts[i] - pts[j];
-          if (d.dot(d) >= grow2 * 4.f) continue;
-          state[static_cast<size_t>(j)] = kGrown;
-          pixels.push_back(j);
-        }
+        for (int k = 0; k < 8; ++k) grow(i + offset[k], grow2);
+        for (int k = 8; k < 16; ++k)
+          if (!valid_point(pts[i + offset[k - 8]])) grow(i + offset[k], grow2 * 4.f);
         continue;
       }
       for (int k = 0; k < 16; ++k) {
         const int step = k < 8 ? 1 : 2;
         const int xx = x + step * kDx[k % 8], yy = y + step * kDy[k % 8];
         if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
-        const int j = yy * width + xx;
-        if (state[static_cast<size_t>(j)] != kRemaining) continue;
         if (step == 2 && valid_point(pts[i + offset[k - 8]])) continue;
-        const cv::Vec3f d = pts[i] - pts[j];
-        if (d.dot(d) >= grow2 * static_cast<float>(step * step)) continue;
-        state[static_cast<size_t>(j)] = kGrown;
-        pixels.push_back(j);
+        grow(yy * width + xx, grow2 * static_cast<float>(step * step));
       }
     }
     segments.push_back({begin, pixels.size(), cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1)});
