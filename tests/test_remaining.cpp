@@ -14,15 +14,16 @@ namespace {
 struct Case {
   cv::Mat depth = cv::Mat(30, 40, CV_32F, cv::Scalar(1.0f));
   cv::Mat labels = cv::Mat(30, 40, CV_32S, cv::Scalar(0));
-  cv::Mat points() const {
+  static Camera camera() {
     Camera c;
     c.fx = c.fy = 525;
     c.cx = 20;
     c.cy = 15;
     c.width = 40;
     c.height = 30;
-    return depth_to_points(depth, c);
+    return c;
   }
+  cv::Mat points() const { return depth_to_points(depth, camera()); }
   cv::Mat run(const std::vector<int>& object_of_patch, int num_objects, int tiny = 20) const {
     return assign_remaining(labels, object_of_patch, num_objects, points(), NormalPlanes{}, Params::Remaining{}, tiny);
   }
@@ -120,12 +121,7 @@ TEST(Remaining, AHiddenSegmentOnTheFarPartsPlaneJoinsItAcrossTheOccluder) {
     c.depth(cv::Rect(0, 10, 8, 8)).setTo(z);
     Params::Remaining params;
     params.hidden_coplanar_band = band;
-    Camera camera;
-    camera.fx = camera.fy = 525;
-    camera.cx = 20;
-    camera.cy = 15;
-    camera.width = 40;
-    camera.height = 30;
+    const Camera camera = Case::camera();
     return assign_remaining(c.labels, {0, 1}, 2, c.points(), NormalPlanes{}, params, 20, {}, &camera).at<int>(14, 3);
   };
   for (const bool shadow : {false, true}) {
