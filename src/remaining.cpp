@@ -53,10 +53,6 @@ constexpr double kHiddenRingShare = 0.06;
 // at most this many faces near it are fitted.
 constexpr double kCoplanarShare = 0.8;
 constexpr size_t kCoplanarCandidates = 6;
-// The occlusion check between them: a sample behind the 3D segment by more than kBehindTolerance is a gap
-// (background seen between), and more than kBehindFraction of such samples fail it (co-planarity's defaults).
-constexpr double kBehindTolerance = 0.01;
-constexpr double kBehindFraction = 0.05;
 
 struct Segment {
   size_t begin, end;  // its pixels in the list of all segments' pixels
@@ -140,7 +136,7 @@ bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, con
 cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
                          int num_objects, const cv::Mat& points, const NormalPlanes& normals,
                          const Params::Remaining& params, int tiny_px, const std::optional<TableHint>& table,
-                         const Camera* camera) {
+                         const OcclusionCheck* occlusion) {
   if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || assigned_labels.size() != points.size())
     throw Error("assign_remaining: labels must be CV_32S and points CV_32FC3 of the same size");
   const bool have_normals = !normals[0].empty();
@@ -238,7 +234,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   std::vector<uchar> on_face;  // per segment pixel: on a face of the object looked at
   const auto coplanar_object = [&](std::span<const int> seg_pixels, const cv::Rect& bbox, int occluder) {
     const auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
-    if (!camera) return 0;
+    if (!occlusion) return 0;
     Eigen::Vector3f own_centroid = Eigen::Vector3f::Zero();
     for (int i : seg_pixels) own_centroid += Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
     own_centroid /= static_cast<float>(seg_pixels.size());
@@ -262,7 +258,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       Plane plane;
       Eigen::Vector3f centroid;
       if (!fit_plane_near(assigned_labels, points, l, bbox, plane, centroid)) continue;
-      if (behind_fraction(own_centroid, centroid, points, *camera, kBehindTolerance) > kBehindFraction) continue;
+      if (behind_fraction(own_centroid, centroid, points, occlusion->camera, occlusion->tolerance) > occlusion->max_fraction)
+        continue;  // background between them: not seen through a nearer thing
       faces_near.emplace_back(object_of(l), plane);
     }
     int best_object = 0;

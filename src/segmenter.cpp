@@ -151,9 +151,10 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
     table_hint = TableHint{*table, {}, p.support.pixel_band};
     for (const Patch& patch : r.patches) table_hint->table_patch.push_back(patch.table);
   }
+  const OcclusionCheck occlusion{camera, p.coplanarity.behind_tolerance, p.coplanarity.behind_fraction};
   r.object_labels = assign_remaining(r.patch_labels, parts.object_of_node,                       // j) remaining
                                      static_cast<int>(parts.cut_cost.size()), r.points, r.normals, p.remaining,
-                                     px.area(p.remaining.tiny_px), table_hint, &camera);
+                                     px.area(p.remaining.tiny_px), table_hint, &occlusion);
   watch.mark("remaining");
   r.objects = describe_objects(r.object_labels, r.points, parts.object_of_node, parts.cut_cost, camera);  // objects
   r.support_plane = table;

@@ -121,8 +121,9 @@ TEST(Remaining, AHiddenSegmentOnTheFarPartsPlaneJoinsItAcrossTheOccluder) {
     c.depth(cv::Rect(0, 10, 8, 8)).setTo(z);
     Params::Remaining params;
     params.hidden_coplanar_band = band;
-    const Camera camera = Case::camera();
-    return assign_remaining(c.labels, {0, 1}, 2, c.points(), NormalPlanes{}, params, 20, {}, &camera).at<int>(14, 3);
+    const Params::Coplanarity coplanarity;
+    const OcclusionCheck occlusion{Case::camera(), coplanarity.behind_tolerance, coplanarity.behind_fraction};
+    return assign_remaining(c.labels, {0, 1}, 2, c.points(), NormalPlanes{}, params, 20, {}, &occlusion).at<int>(14, 3);
   };
   for (const bool shadow : {false, true}) {
     EXPECT_EQ(run(1.1f, 0.008, shadow), 2) << shadow;  // on the far part's plane: that object

@@ -12,4 +12,12 @@ namespace clutterseg {
 double behind_fraction(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const cv::Mat& points,
                        const Camera& camera, double tolerance);
 
+// The check as a stage outside co-planarity runs it: the camera and co-planarity's settings
+// (Params::Coplanarity::behind_tolerance and behind_fraction), so that both stages judge a gap alike.
+struct OcclusionCheck {
+  Camera camera;
+  double tolerance;     // a sample is behind when deeper than the segment by this [m]
+  double max_fraction;  // the gap is background when more samples than this share lie behind [-]
+};
+
 }  // namespace clutterseg

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "clutterseg/normals.hpp"
+#include "clutterseg/occlusion.hpp"
 #include "clutterseg/params.hpp"
 #include "clutterseg/types.hpp"
 
@@ -23,12 +24,12 @@ struct TableHint {
 // objects' faces that is a face of its own (its normals differ from every neighbouring face's) joins the
 // face it meets in a convex edge, and a segment seen behind its one face across depth jumps larger than
 // params.occluded_jump is an object of its own (both beyond the paper; docs/OBJECTS.md). tiny_px is
-// already scaled to the resolution. normals may be empty (no face-of-its-own rule). With the camera, a
+// already scaled to the resolution. normals may be empty (no face-of-its-own rule). With `occlusion`, a
 // segment that would be an object of its own but lies on the planes of another object's faces near it, with
 // only nearer things between, joins that object (params.hidden_coplanar_band; without it, no such joins).
 cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
                          int num_objects, const cv::Mat& points, const NormalPlanes& normals,
                          const Params::Remaining& params, int tiny_px, const std::optional<TableHint>& table = {},
-                         const Camera* camera = nullptr);
+                         const OcclusionCheck* occlusion = nullptr);
 
 }  // namespace clutterseg
