@@ -19,7 +19,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Adjacency, radius_px, d_
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::CutFree, enabled, planes, band, wrong_side_fraction, skip_angle_deg, skip_similar)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Convexity, enabled, tolerance, step, concave_weight)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Coplanarity, enabled, angle_deg, triples, lines, behind_fraction, behind_tolerance, lines_pass, max_gap)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Curvature, enabled, theta_h, open_objects, occluded, line_fit, neighbour_gap_px)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Curvature, enabled, theta_h, open_objects, occluded, line_fit, neighbour_gap_px, concentric)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::GraphCut, theta_c)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Remaining, grow_distance, tiny_px, hole_px, shadow_baseline, occluded_jump,
                                                 hidden_coplanar_band)

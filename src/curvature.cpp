@@ -180,6 +180,63 @@ bool aligned_and_occluded(const Patch& a, const BinnedPixels& binned_a, const Pa
          params.coplanarity.behind_fraction;
 }
 
+// Where a curved patch's normal lines meet: the centre of a sphere, or the axis of a cylinder (when the
+// normals all lie across one direction). The walls of one cup or bowl share it; two objects side by
+// side do not. Least squares over the lines p + t n: sum (I - n n^T) c = sum (I - n n^T) p.
+struct CurvatureCentre {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();  // zero for a point
+  double radius = 0;                               // mean distance of the patch's points to the centre
+  bool valid = false;
+
+  double distance(const Eigen::Vector3d& x) const {
+    const Eigen::Vector3d d = x - point;
+    return (d - d.dot(axis) * axis).norm();
+  }
+};
+
+// A direction whose eigenvalue is below this share of the largest one carries no information: the normals
+// barely turn across it (a cylinder's axis; for the second direction too, a plane: no centre).
+constexpr double kFlatDirection = 0.08;
+
+CurvatureCentre curvature_centre(const Patch& patch, const cv::Mat& points, const NormalPlanes& normals) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
+  const size_t stride = std::max<size_t>(1, patch.pixels.size() / kConvexitySamples);
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> sample;
+  for (size_t k = 0; k < patch.pixels.size(); k += stride) {
+    const int i = patch.pixels[k];
+    const Eigen::Vector3d n(nx[i], ny[i], nz[i]);
+    if (!(pts[i][2] > 0) || n.squaredNorm() < 0.5) continue;
+    const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - n * n.transpose();
+    sample.push_back(vec(pts[i]).cast<double>());
+    a += across;
+    b += across * sample.back();
+  }
+  CurvatureCentre centre;
+  if (sample.size() < 10) return centre;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(a);  // eigenvalues ascending
+  const Eigen::Vector3d lambda = eig.eigenvalues();
+  if (!(lambda(2) > 0) || lambda(1) < kFlatDirection * lambda(2)) return centre;
+  const int first = lambda(0) < kFlatDirection * lambda(2) ? 1 : 0;  // 1: a cylinder, its axis dropped
+  for (int k = first; k < 3; ++k) centre.point += eig.eigenvectors().col(k).dot(b) / lambda(k) * eig.eigenvectors().col(k);
+  if (first == 1) centre.axis = eig.eigenvectors().col(0);
+  for (const auto& x : sample) centre.radius += centre.distance(x);
+  centre.radius /= static_cast<double>(sample.size());
+  centre.valid = std::isfinite(centre.radius);
+  return centre;
+}
+
+// The walls of one open object: the inner wall's centre lies on the outer wall's (a point or its axis)
+// within `share` of the outer wall's radius, and the inner wall is not the larger.
+bool concentric(const CurvatureCentre& outer, const CurvatureCentre& inner, double share) {
+  if (!outer.valid || !inner.valid || inner.radius > outer.radius * (1 + share)) return false;
+  const double d = outer.axis.isZero() && !inner.axis.isZero() ? inner.distance(outer.point) : outer.distance(inner.point);
+  return d <= share * outer.radius;
+}
+
 }  // namespace
 
 double histogram_similarity(const std::vector<float>& a, const std::vector<float>& b) {
@@ -247,8 +304,9 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   for (size_t i = 0; i < patches.size(); ++i)
     if (patches[i].curved && !patches[i].pixels.empty()) curved.push_back(static_cast<int>(i));
 
-  // Similar histograms first (121 bins per pair); the pixel work only for the similar pairs.
-  std::vector<PatchPair> similar;
+  // Similar histograms first (121 bins per pair); the pixel work only for the similar pairs and, for the
+  // concentric-walls rule, the others.
+  std::vector<PatchPair> similar, walls;
   for (size_t x = 0; x < curved.size(); ++x)
     for (size_t y = x + 1; y < curved.size(); ++y) {
       const int i = curved[x], j = curved[y];
@@ -257,8 +315,9 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
       const auto& b = patches[static_cast<size_t>(j)];
       if (a.histogram.size() != b.histogram.size() || a.histogram.empty()) continue;
       if (histogram_similarity(a.histogram, b.histogram) > p.theta_h) similar.emplace_back(i, j);
+      else if (p.open_objects && p.concentric > 0) walls.emplace_back(i, j);
     }
-  if (similar.empty()) return out;
+  if (similar.empty() && walls.empty()) return out;
 
   const PixelScale px(camera.fx, camera.fy);
   const int gap = px.length(p.neighbour_gap_px);
@@ -272,23 +331,43 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
     if (c == 2) c = convexity(patches[static_cast<size_t>(i)], points, normals, histogram_side(patches[static_cast<size_t>(i)].histogram));
     return c;
   };
-  // Boundaries of all similar patches in one pass over the image, the first time a pair needs them.
+  // An open object's walls whose histograms differ (a bowl's outer wall faces down and out, the inside
+  // seen over the rim up and in): opposite convexity, and concentric (beyond the paper). Decided here, so
+  // that the boundary pass below covers only the pairs left.
+  // Boxes first: most pairs lie apart in the image, and their convexity is not needed.
+  const auto apart = [&](int i, int j) {
+    return (grown(box_of(patches[static_cast<size_t>(i)]), gap) & box_of(patches[static_cast<size_t>(j)])).area() == 0;
+  };
+  std::vector<std::unique_ptr<CurvatureCentre>> centres(patches.size());
+  auto centre_of = [&](int i) -> const CurvatureCentre& {
+    auto& c = centres[static_cast<size_t>(i)];
+    if (!c) c = std::make_unique<CurvatureCentre>(curvature_centre(patches[static_cast<size_t>(i)], points, normals));
+    return *c;
+  };
+  std::erase_if(walls, [&](const PatchPair& pair) {
+    const auto [i, j] = pair;
+    if (apart(i, j) || convexity_of(i) * convexity_of(j) != -1) return true;
+    const bool i_outer = convexity_of(i) > 0;
+    return !concentric(centre_of(i_outer ? i : j), centre_of(i_outer ? j : i), p.concentric);
+  });
+  // Boundaries of all these patches in one pass over the image, the first time a pair needs them.
   std::vector<std::vector<cv::Point>> boundary_by_id;
   auto boundary_of = [&](int i) -> const std::vector<cv::Point>& {
     if (boundary_by_id.empty()) {
       std::vector<char> wanted;
       int y_begin = assigned_labels.rows, y_end = 0;  // the rows of their boxes: only these hold their pixels
-      for (const auto& [x, y] : similar)
-        for (const int k : {x, y}) {
-          const Patch& patch = patches[static_cast<size_t>(k)];
-          const int id = patch.id;
-          if (id > static_cast<int>(wanted.size())) wanted.resize(static_cast<size_t>(id), 0);
-          if (id <= 0) continue;
-          wanted[static_cast<size_t>(id - 1)] = 1;
-          const cv::Rect box = box_of(patch);
-          y_begin = std::min(y_begin, box.y);
-          y_end = std::max(y_end, box.y + box.height);
-        }
+      for (const auto* pairs : {&similar, &walls})
+        for (const auto& [x, y] : *pairs)
+          for (const int k : {x, y}) {
+            const Patch& patch = patches[static_cast<size_t>(k)];
+            const int id = patch.id;
+            if (id > static_cast<int>(wanted.size())) wanted.resize(static_cast<size_t>(id), 0);
+            if (id <= 0) continue;
+            wanted[static_cast<size_t>(id - 1)] = 1;
+            const cv::Rect box = box_of(patch);
+            y_begin = std::min(y_begin, box.y);
+            y_end = std::max(y_end, box.y + box.height);
+          }
       boundary_by_id = boundaries(assigned_labels, wanted, y_begin, y_end);
     }
     return boundary_by_id[static_cast<size_t>(patches[static_cast<size_t>(i)].id - 1)];
@@ -296,7 +375,7 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   auto neighbours = [&](int i, int j) {
     const auto& a = patches[static_cast<size_t>(i)];
     const auto& b = patches[static_cast<size_t>(j)];
-    if (a.id <= 0 || b.id <= 0 || (grown(box_of(a), gap) & box_of(b)).area() == 0) return false;
+    if (a.id <= 0 || b.id <= 0 || apart(i, j)) return false;
     return within_gap(boundary_of(i), boundary_of(j), gap, assigned_labels.size());
   };
   std::vector<std::unique_ptr<BinnedPixels>> binned(patches.size());
@@ -322,6 +401,8 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
     if (p.occluded && aligned_and_occluded(a, binned_of(i), b, binned_of(j), points, camera, params) && !neighbours(i, j))
       out.push_back({{i, j}, Cue::CurvatureOccluded});
   }
+  for (const auto& [i, j] : walls)
+    if (neighbours(i, j)) out.push_back({{i, j}, Cue::CurvatureOpen});
   return out;
 }
 

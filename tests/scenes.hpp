@@ -113,6 +113,17 @@ inline TestScene occluded_box_split() {
 }
 
 // Two lying cylinders on one axis with bare table between them: aligned, similar, but not occluded.
+// A bowl (a spherical shell cut at its rim) standing on the table: rim at `height`, wall `wall` thick.
+inline Shape bowl(int label, Eigen::Vector3d base, double radius, double height, double wall = 0.005) {
+  Shape s;
+  s.type = ShapeType::Bowl;
+  s.pose = Eigen::Translation3d(base + Eigen::Vector3d(0, 0, height / 2)) * Eigen::Isometry3d::Identity();
+  s.size = {radius, radius, height / 2};
+  s.wall = wall;
+  s.label = label;
+  return s;
+}
+
 inline TestScene coaxial_cylinders() {
   return {{{table(), lying_cylinder(1, {-0.11, 0.05, 0.04}, 0.04, 0.07), lying_cylinder(2, {0.11, 0.05, 0.04}, 0.04, 0.07)}}};
 }

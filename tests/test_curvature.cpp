@@ -161,3 +161,43 @@ TEST(Curvature, SameDecisionsAtVga) {
   EXPECT_EQ(links[0].cue, Cue::CurvatureOccluded);
   EXPECT_TRUE(links_of(segment_scene(coaxial), coaxial).empty());
 }
+
+// Beyond the paper: a bowl's outer wall faces down and out, its inside seen over the rim up and in, so their
+// histograms differ and the paper's open-object rule never tries them; their normal lines meet at one centre.
+TEST(Curvature, ConcentricRuleLinksTheBowlWallsOnly) {
+  TestScene bowl_alone{{{table(), bowl(1, {0, 0, 0}, 0.08, 0.06)}}};
+  bowl_alone.world_to_camera = synth::look_at({0, -0.6, 0.4}, {0, 0, 0.03});  // low enough to see the outer wall
+  // A can standing behind the bowl, seen above its far rim: convex next to the concave inside in the image,
+  // their histograms apart too, but its axis far from the bowl's centre.
+  TestScene can_behind{{{table(), bowl(1, {0, 0, 0}, 0.08, 0.06), standing(ShapeType::Cylinder, 2, {0, 0.13, 0}, 0.035, 0.16)}}};
+  can_behind.world_to_camera = bowl_alone.world_to_camera;
+  Params off;
+  off.curvature.concentric = 0;
+  for (const TestScene* scene : {&bowl_alone, &can_behind}) {
+    const Segmented s = segment_scene(*scene);
+    const auto walls = patches_on(s, 1);
+    ASSERT_EQ(walls.size(), 2u);
+    const Patch &a = patch(s, walls[0]), &b = patch(s, walls[1]);
+    ASSERT_TRUE(a.curved && b.curved);
+    EXPECT_LT(histogram_similarity(a.histogram, b.histogram), off.curvature.theta_h);
+    EXPECT_EQ(convexity(a, s.result.points, s.result.normals, 11) * convexity(b, s.result.points, s.result.normals, 11), -1);
+    if (scene == &can_behind) {  // the can is there to be wrongly joined: convex, unlike the inside
+      const auto can = patches_on(s, 2);
+      ASSERT_FALSE(can.empty());
+      const Patch& inside = patch(s, convexity(a, s.result.points, s.result.normals, 11) < 0 ? walls[0] : walls[1]);
+      for (int c : can) {
+        EXPECT_EQ(convexity(patch(s, c), s.result.points, s.result.normals, 11), 1);
+        EXPECT_LT(histogram_similarity(patch(s, c).histogram, inside.histogram), off.curvature.theta_h);
+      }
+    }
+    // The rule adds exactly the link between the two walls.
+    auto added = links_of(s, *scene);
+    const auto without = links_of(s, *scene, off);
+    std::erase_if(added, [&](const CurvatureLink& l) {
+      return std::any_of(without.begin(), without.end(), [&](const CurvatureLink& w) { return w.pair == l.pair; });
+    });
+    ASSERT_EQ(added.size(), 1u) << (scene == &can_behind ? "can behind" : "bowl");
+    EXPECT_EQ(added[0].pair, PatchPair(std::min(walls[0], walls[1]), std::max(walls[0], walls[1])));
+    EXPECT_EQ(added[0].cue, Cue::CurvatureOpen);
+  }
+}

@@ -20,7 +20,9 @@ struct CurvatureLink {
 
 // Links between curved patches not already in `linked`: similar histograms (S > theta_h) and either
 // image neighbours of opposite convexity (open object), or a 3D line through both patches' peak-bin
-// points that fits within line_fit and passes the occlusion check (occluded curved object).
+// points that fits within line_fit and passes the occlusion check (occluded curved object). Beyond the
+// paper, image neighbours of opposite convexity whatever their histograms whose normals meet at one
+// centre or axis (params.curvature.concentric; an open object's outer wall and its inside).
 std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches,
                                            const std::vector<PatchPair>& linked,
                                            const cv::Mat& assigned_labels, const cv::Mat& points,

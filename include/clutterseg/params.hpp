@@ -95,6 +95,10 @@ struct Params {
     bool occluded = true;        // curved patches split by an occluder (line through peak-bin points)
     double line_fit = 0.01;      // RMS distance of peak-bin points to their fitted 3D line [m]
     double neighbour_gap_px = 7; // open-object patches are image neighbours within this at 320x240 [px]
+    double concentric = 0.4;     // beyond the paper: a convex and a concave image neighbour whose histograms
+                                 // differ (a bowl's outer wall and its inside) are one open object when their
+                                 // centres of curvature (sphere centre or cylinder axis) lie within this share
+                                 // of the outer wall's radius [-]; 0 = off
   } curvature;
 
   // i) Graph cut on the patch graph: w_ij = 1/deg(i), symmetrised.
