@@ -198,11 +198,12 @@ struct CurvatureCentre {
 // A direction whose eigenvalue is below this share of the largest one carries no information: the normals
 // barely turn across it (a cylinder's axis; for the second direction too, a plane: no centre).
 constexpr double kFlatDirection = 0.08;
+constexpr size_t kCentreSamples = 256;  // pixels used at most for a patch's centre: a least-squares point
 
 CurvatureCentre curvature_centre(const Patch& patch, const cv::Mat& points, const NormalPlanes& normals) {
   const auto* pts = points.ptr<cv::Vec3f>();
   const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
-  const size_t stride = std::max<size_t>(1, patch.pixels.size() / kConvexitySamples);
+  const size_t stride = std::max<size_t>(1, patch.pixels.size() / kCentreSamples);
   Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> sample;
