@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "clutterseg/occlusion.hpp"
 #include "clutterseg/parallel.hpp"
@@ -334,15 +335,15 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   };
   // An open object's walls whose histograms differ (a bowl's outer wall faces down and out, the inside
   // seen over the rim up and in): opposite convexity, and concentric (beyond the paper). Decided here, so
-  // that the boundary pass below covers only the pairs left.
-  // Boxes first: most pairs lie apart in the image, and their convexity is not needed.
+  // that the boundary pass below covers only the pairs left. Boxes first: most pairs lie apart in the
+  // image, and their convexity is not needed.
   const auto apart = [&](int i, int j) {
     return (grown(box_of(patches[static_cast<size_t>(i)]), gap) & box_of(patches[static_cast<size_t>(j)])).area() == 0;
   };
-  std::vector<std::unique_ptr<CurvatureCentre>> centres(patches.size());
+  std::vector<std::optional<CurvatureCentre>> centres(patches.size());  // fitted the first time a pair needs one
   auto centre_of = [&](int i) -> const CurvatureCentre& {
     auto& c = centres[static_cast<size_t>(i)];
-    if (!c) c = std::make_unique<CurvatureCentre>(curvature_centre(patches[static_cast<size_t>(i)], points, normals));
+    if (!c) c = curvature_centre(patches[static_cast<size_t>(i)], points, normals);
     return *c;
   };
   std::erase_if(walls, [&](const PatchPair& pair) {

@@ -112,7 +112,6 @@ inline TestScene occluded_box_split() {
   return {{{table(), box(1, {0, 0.08, 0.06}, {0.15, 0.05, 0.06}), box(2, {0, -0.08, 0.15}, {0.025, 0.025, 0.15})}}};
 }
 
-// Two lying cylinders on one axis with bare table between them: aligned, similar, but not occluded.
 // A bowl (a spherical shell cut at its rim) standing on the table: rim at `height`, wall `wall` thick.
 inline Shape bowl(int label, Eigen::Vector3d base, double radius, double height, double wall = 0.005) {
   Shape s;
@@ -124,6 +123,7 @@ inline Shape bowl(int label, Eigen::Vector3d base, double radius, double height,
   return s;
 }
 
+// Two lying cylinders on one axis with bare table between them: aligned, similar, but not occluded.
 inline TestScene coaxial_cylinders() {
   return {{{table(), lying_cylinder(1, {-0.11, 0.05, 0.04}, 0.04, 0.07), lying_cylinder(2, {0.11, 0.05, 0.04}, 0.04, 0.07)}}};
 }
