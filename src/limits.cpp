@@ -52,6 +52,8 @@ void validate(const Params& p) {
   in_range("patches.occupied_share", p.patches.occupied_share, 0, 1);
   int_range("patches.flat_max_bins", p.patches.flat_max_bins, 1, 64 * 64);
   in_range("patches.split_band", p.patches.split_band, 0, 1);
+  in_range("patches.seam_theta", p.patches.seam_theta, 0, 1);
+  in_range("patches.seam_spread_deg", p.patches.seam_spread_deg, 0, 90);
   in_range("adjacency.radius_px", p.adjacency.radius_px, 0, 50);
   above("adjacency.d_max", p.adjacency.d_max, 0, 1);
   int_range("cutfree.planes", p.cutfree.planes, 1, 1000);
@@ -61,6 +63,7 @@ void validate(const Params& p) {
   in_range("convexity.tolerance", p.convexity.tolerance, 0, 2);
   in_range("convexity.step", p.convexity.step, 0, 1);
   in_range("convexity.concave_weight", p.convexity.concave_weight, 0, 1);
+  in_range("convexity.step_offset", p.convexity.step_offset, 0, 1);
   in_range("coplanarity.angle_deg", p.coplanarity.angle_deg, 0, 180);
   int_range("coplanarity.triples", p.coplanarity.triples, 1, 10000);
   int_range("coplanarity.lines", p.coplanarity.lines, 1, 1000);

@@ -14,11 +14,6 @@ namespace clutterseg {
 
 namespace {
 
-// One run of a connected component along an image row: its pixels are contiguous in memory.
-struct Run {
-  int component, y, x0, x1;  // columns [x0, x1)
-};
-
 // Sums over the pixels of one connected component.
 struct ComponentSums {
   int area = 0;
@@ -87,12 +82,12 @@ CLUTTERSEG_AVX2_KERNEL void normal_bins(const float* __restrict nx, const float*
   for (int k = 0; k < n; ++k) out[k] = normal_bin(nx[k], ny[k], bins);
 }
 
-// The runs of non-edge pixels, row after row, and their 4-connected components: two runs of adjacent
-// rows that share a column are joined (union-find over runs, the smaller index as root), and components
-// are numbered 1, 2, ... in raster order of their first pixel, as cv::connectedComponents numbers them.
-// Returns the number of components plus one (0 is the edges). The runs are what the statistics below
-// read, so labelling them directly costs a few operations per run instead of a pass over every pixel.
-int label_runs(const cv::Mat& edges, std::vector<Run>& runs) {
+}  // namespace
+
+// Two runs of adjacent rows that share a column are joined (union-find over runs, the smaller index as
+// root). The runs are what the patch statistics read, so labelling them directly costs a few operations
+// per run instead of a pass over every pixel.
+int label_runs(const cv::Mat& edges, std::vector<LabelRun>& runs) {
   std::vector<int> parent;
   const auto root = [&](int i) {
     while (parent[static_cast<size_t>(i)] != i)  // path halving: each step shortens the path
@@ -129,8 +124,6 @@ int label_runs(const cv::Mat& edges, std::vector<Run>& runs) {
   return count;
 }
 
-}  // namespace
-
 namespace {
 
 // extract_patches, and update_patches when `previous` is given: a component with exactly the pixels of
@@ -141,13 +134,13 @@ Patches build_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& 
   const bool planes_fit = std::all_of(normals.begin(), normals.end(), [&](const cv::Mat& n) { return fits(n, CV_32F); });
   if (!fits(edges, CV_8U) || !fits(depth, CV_32F) || !planes_fit)
     throw Error("extract_patches: edges (CV_8U), depth and the normal planes (CV_32F) must be images of one size");
-  std::vector<Run> runs;
+  std::vector<LabelRun> runs;
   const int count = label_runs(edges, runs);
   const int bins = params.histogram_bins, cols = edges.cols;
   // First each component's area and box; then the statistics, only for the components that are large
   // enough to become patches (most components are specks along the edges).
   std::vector<ComponentSums> sums(static_cast<size_t>(count));
-  for (const Run& run : runs) {
+  for (const LabelRun& run : runs) {
     ComponentSums& s = sums[static_cast<size_t>(run.component)];
     s.area += run.x1 - run.x0;
     s.x0 = std::min(s.x0, run.x0);
@@ -162,7 +155,7 @@ Patches build_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& 
   if (previous) {
     const int* old_label = previous->labels.ptr<int>();
     int next = 1;  // components are numbered in the raster order of their first run
-    for (const Run& run : runs) {
+    for (const LabelRun& run : runs) {
       if (run.component != next) continue;  // not the component's first run
       ++next;
       const int old = old_label[run.y * cols + run.x0];
@@ -184,7 +177,7 @@ Patches build_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& 
   const std::vector<float> rays = ray_x(camera, cols);
   std::vector<float> row_rays(static_cast<size_t>(edges.rows));
   for (int y = 0; y < edges.rows; ++y) row_rays[static_cast<size_t>(y)] = ray_y(camera, y);
-  for (const Run& run : runs) {
+  for (const LabelRun& run : runs) {
     if (!measured(run.component)) continue;
     ComponentSums& s = sums[static_cast<size_t>(run.component)];
     const int n = run.x1 - run.x0;
@@ -247,7 +240,7 @@ Patches build_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& 
   out.labels = cv::Mat(edges.size(), CV_32S);
   int* const labels = out.labels.ptr<int>();
   size_t done = 0;  // pixels written, in raster order
-  for (const Run& run : runs) {
+  for (const LabelRun& run : runs) {
     const size_t begin = static_cast<size_t>(run.y) * static_cast<size_t>(cols), from = begin + static_cast<size_t>(run.x0);
     std::fill(labels + done, labels + from, 0);
     done = begin + static_cast<size_t>(run.x1);

@@ -13,6 +13,7 @@
 #include "clutterseg/parallel.hpp"
 #include "clutterseg/holes.hpp"
 #include "clutterseg/remaining.hpp"
+#include "clutterseg/seams.hpp"
 #include "clutterseg/stopwatch.hpp"
 #include "clutterseg/support.hpp"
 
@@ -105,20 +106,26 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   watch.mark("pointcloud");
   const std::optional<Plane> table = p.support.enabled                           // the table (beyond the paper)
       ? find_support_plane(r.patches, r.points, camera, p.support) : std::nullopt;
+  const auto mark_table = [&] {
+    if (!table) return;
+    for (Patch& patch : r.patches) patch.table = lies_in(patch, r.points, *table, p.support);
+    unmark_curved_table(r.patches, p.support);                                   // a bowl's floor is no table
+  };
+  mark_table();
   const int cut = (table ? cut_off_table(r.edges, r.patches, r.core_patch_labels, r.points, *table, p.support,  // objects
                                          px.area(p.patches.min_size_px)) : 0) +                           // left in it
                   (p.patches.split_band > 0 ? split_at_planes(r.edges, r.patches, r.core_patch_labels, r.points,   // patches
                                                               p.patches.split_band, px.area(p.patches.min_size_px),  // of two
-                                                              table, p.support) : 0);                                 // planes
+                                                              table, p.support) : 0) +                                // planes,
+                  split_at_seams(r.edges, r.patches, r.core_patch_labels, r.edge_value, r.normals, p.patches,  // or of two
+                                 px.area(p.patches.min_size_px), r.points, table, p.support);                  // faces
   if (cut > 0) {  // measure again only the patches the cuts went through
     patches = update_patches({r.core_patch_labels, std::move(r.patches)}, r.edges, r.depth, camera, r.normals,
                              p.patches, px.area(p.patches.min_size_px));
     r.core_patch_labels = patches.labels;
     r.patches = std::move(patches.patches);
+    mark_table();
   }
-  if (table)
-    for (Patch& patch : r.patches) patch.table = lies_in(patch, r.points, *table, p.support);
-  if (table) unmark_curved_table(r.patches, p.support);                          // a bowl's floor is no table
   watch.mark("support");
   const int num_patches = static_cast<int>(r.patches.size());
   Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency
@@ -131,7 +138,7 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
       ? cut_free_pairs(adjacent, r.patches, r.points, p.cutfree, p.seed) : adjacent;
   watch.mark("cutfree");
   const std::vector<PairJunction> junctions = p.convexity.enabled                         // convex or concave
-      ? classify_junctions(assignment.contacts, r.points, r.normals, p.convexity) : std::vector<PairJunction>{};
+      ? classify_junctions(assignment.contacts, r.points, r.normals, p.convexity, r.patches) : std::vector<PairJunction>{};
   watch.mark("convexity");
   std::vector<PatchPair> linked = links;
   const std::vector<PatchPair> coplanar = p.coplanarity.enabled                         // f/g) co-planarity

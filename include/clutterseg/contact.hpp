@@ -5,6 +5,8 @@
 // the table or is the table's own edge. docs/COMPOSITION.md has the measurements behind the defaults.
 #pragma once
 
+#include <span>
+
 #include "clutterseg/adjacency.hpp"
 #include "clutterseg/normals.hpp"
 #include "clutterseg/params.hpp"
@@ -29,8 +31,12 @@ struct PairJunction {
 // stride), from the points and the normals (camera-facing) at the two contact pixels. Convex above
 // +tolerance, concave below -tolerance, else a step when step > Params::Convexity::step, else flat
 // (coplanar continuations); a pair seen by fewer than 3 contacts needs a crease 3 / samples times as
-// sharp. Sorted by pair.
+// sharp. Beyond that, with `patches` (indexed as the contacts' a and b) and params.step_offset > 0: two
+// patches whose mean normals are within 10 deg, whose contacts lie offset along the bisector of those
+// normals by more than step_offset * max(1, z^2) on average (z their mean depth; 3 / samples times that
+// for fewer than 3 contacts), meet in a step, before the convexity is looked at. Sorted by pair.
 std::vector<PairJunction> classify_junctions(const std::vector<Contact>& contacts, const cv::Mat& points,
-                                             const NormalPlanes& normals, const Params::Convexity& params);
+                                             const NormalPlanes& normals, const Params::Convexity& params,
+                                             std::span<const Patch> patches = {});
 
 }  // namespace clutterseg

@@ -45,6 +45,12 @@ struct Params {
     double split_band = 0.008;   // beyond the paper: a flat patch with a part of at least min_size_px
                                  // farther than this from its dominant plane is split there [m at 1 m,
                                  // times z^2 beyond]; 0 = off
+    double seam_theta = 0.96;    // beyond the paper: a patch whose pixels with an edge value of at least
+                                 // this form two or more parts of min_size_px is split along the band of
+                                 // weaker pixels between them (a crease too shallow for theta: two stacked
+                                 // boxes' fronts; seams.hpp) [-]; 0 = off
+    double seam_spread_deg = 15; // ... when every part is nearly planar: its normals' mean angle to their
+                                 // mean within this (or the patch is table) [deg]
   } patches;
 
   // d) Adjacency and assignment of edge pixels to the nearest patch.
@@ -73,6 +79,9 @@ struct Params {
                                  // it are offset along the normal by more than this share of their distance
                                  // (sin of 30 deg) [-]
     double concave_weight = 0.2; // a concave or step link's graph weight is multiplied by this [-]
+    double step_offset = 0.003;  // beyond: parallel faces (mean normals within 10 deg) offset along their
+                                 // common normal by more than this across the contacts meet in a step,
+                                 // whatever the contact normals say [m at 1 m, times z^2 beyond]; 0 = off
   } convexity;
 
   // f/g) Co-planarity of flat, non-adjacent patches separated by occlusion.

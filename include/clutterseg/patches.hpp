@@ -25,6 +25,16 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
 Patches update_patches(Patches previous, const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
                        const NormalPlanes& normals, const Params::Patches& params, int min_size);
 
+// One run of a connected component along an image row: columns [x0, x1) of row y.
+struct LabelRun {
+  int component, y, x0, x1;
+};
+
+// The runs of zero pixels of `edges` (CV_8U), row after row, and their 4-connected components, numbered
+// 1, 2, ... in raster order of their first pixel, as cv::connectedComponents numbers them (the patches
+// before the size limit). Appends to `runs`; returns the number of components plus one (0 is the edges).
+int label_runs(const cv::Mat& edges, std::vector<LabelRun>& runs);
+
 // The bin of a unit normal (x, y, z) in the (x, y) histogram of normals: bins x bins cells over [-1, 1]^2.
 inline int normal_bin(float x, float y, int bins) {
   auto bin = [bins](float c) { return std::clamp(static_cast<int>((c + 1.f) * 0.5f * bins), 0, bins - 1); };
