@@ -104,26 +104,6 @@ std::vector<std::string> split_names(const std::string& list) {
   return names;
 }
 
-// Every n-th row and column of the depth, with the intrinsics scaled to match: the same scene as a
-// sensor with n times fewer pixels per axis would see it (nearest neighbour, no new values).
-void subsample_frame(Frame& frame, int n) {
-  if (n <= 1) return;
-  cv::Mat depth(frame.depth.rows / n, frame.depth.cols / n, frame.depth.type());
-  for (int y = 0; y < depth.rows; ++y)
-    for (int x = 0; x < depth.cols; ++x)
-      std::memcpy(depth.ptr(y, x), frame.depth.ptr(y * n, x * n), frame.depth.elemSize());
-  frame.depth = depth;
-  frame.color.release();
-  frame.label.release();
-  Camera& c = frame.camera;
-  c.fx /= n;
-  c.fy /= n;
-  c.cx /= n;
-  c.cy /= n;
-  c.width = depth.cols;
-  c.height = depth.rows;
-}
-
 // Both OpenMP (clutterseg's stages) and OpenCV's own pool (median, Gaussian) follow the thread count.
 void use_threads(int threads) {
   set_threads(threads);
@@ -363,7 +343,7 @@ int run(const BenchOptions& o) {
   for (size_t i = 0; i < source.size() && frames.size() < wanted; ++i) {
     try {
       frames.push_back(source.load(i));
-      subsample_frame(frames.back(), o.subsample);
+      subsample(frames.back(), o.subsample);
     } catch (const Error& e) {
       report_error(e.what());
     } catch (const std::exception& e) {  // OpenCV, out of memory: the frame is skipped all the same

@@ -29,6 +29,7 @@ struct EvalOptions {
   std::vector<std::string> with;
   bool sequence = false;
   int report_frames = 24;
+  int subsample = 1;  // keep every N-th row and column (a 640x480 set scored as a 320x240 sensor with N = 2)
   CameraOptions camera;
   ParamOptions params;
 };
@@ -125,6 +126,7 @@ struct Evaluation {
   const std::map<std::string, FrameInfo>& infos;
   fs::path dataset;
   int gallery_frames = 0;
+  int subsample = 1;
 };
 
 // Makes a fresh method: one per scene, so no temporal state leaks from one scene into the next.
@@ -151,7 +153,8 @@ void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord&
       tracking = TrackingScorer();
     }
     try {
-      const Frame frame = ev.source.load(i);
+      Frame frame = ev.source.load(i);
+      subsample(frame, ev.subsample);
       if (frame.label.empty())
         throw Error((ev.dataset / "label" / (name + ".png")).string() + ": no ground truth for this frame");
       MethodOutput out;
@@ -206,6 +209,7 @@ std::string command_line(const EvalOptions& o) {
   }
   if (!o.sweep.empty()) c += " --sweep " + o.sweep;
   if (o.sequence) c += " --sequence";
+  if (o.subsample > 1) c += " --subsample " + std::to_string(o.subsample);
   if (!o.out.empty()) c += " --out " + o.out;
   return c;
 }
@@ -216,6 +220,8 @@ int run(const EvalOptions& o) {
     throw Error(o.dataset + ": is not a dataset folder (SPEC Sec. 3: camera.json, depth/, label/)");
   if (!o.pred.empty() && (!o.with.empty() || !o.sweep.empty()))
     throw Error("--pred scores given predictions; it cannot be combined with --with or --sweep");
+  if (!o.pred.empty() && o.subsample > 1)
+    throw Error("--pred scores given predictions at their own size; it cannot be combined with --subsample");
   const FrameSource source(o.dataset, o.camera);
   const auto infos = frame_infos(o.dataset, source, o.sequence);
   std::optional<Sweep> sweep;
@@ -266,7 +272,7 @@ int run(const EvalOptions& o) {
   if (o.pred.empty()) report.params_json = params_to_json(base);
   if (sweep) report.sweep_parameter = sweep->name;
 
-  const Evaluation ev{source, infos, o.dataset, o.out.empty() ? 0 : std::max(0, o.report_frames)};
+  const Evaluation ev{source, infos, o.dataset, o.out.empty() ? 0 : std::max(0, o.report_frames), o.subsample};
   for (auto& [record, make] : runs) {
     run_over_frames(ev, make, record, report);
     record.groups = summarize(record.frames);
@@ -317,6 +323,8 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--sweep", opts->sweep, "NAME=START:STOP:STEP, e.g. theta_c=0.3:0.9:0.1 (also theta_h, or a --dump-config path)");
   cmd->add_flag("--sequence", opts->sequence, "the frames are one sequence of one scene (unless scenes.json names scenes)");
   cmd->add_option("--report-frames", opts->report_frames, "frames pictured in report.html (default 24)");
+  cmd->add_option("--subsample", opts->subsample, "keep every N-th row and column of depth and labels, intrinsics scaled (2: a 640x480 set scored as 320x240)")
+      ->check(CLI::Range(1, 16));
   opts->camera.add_to(*cmd);
   opts->params.add_to(*cmd);
   cmd->callback([opts] { throw CLI::RuntimeError(run(*opts)); });

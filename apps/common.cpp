@@ -1,5 +1,6 @@
 #include "common.hpp"
 
+#include <cstring>
 #include <unistd.h>
 
 #include <fstream>
@@ -141,6 +142,27 @@ Frame FrameSource::load(size_t i) const {
       throw Error(e.label->string() + ": label image size differs from the depth image");
   }
   return f;
+}
+
+void subsample(Frame& frame, int n) {
+  if (n <= 1) return;
+  const auto every_nth = [n](const cv::Mat& image) {
+    if (image.empty()) return image;
+    cv::Mat out(image.rows / n, image.cols / n, image.type());
+    for (int y = 0; y < out.rows; ++y)
+      for (int x = 0; x < out.cols; ++x) std::memcpy(out.ptr(y, x), image.ptr(y * n, x * n), image.elemSize());
+    return out;
+  };
+  frame.depth = every_nth(frame.depth);
+  frame.color = every_nth(frame.color);
+  frame.label = every_nth(frame.label);
+  Camera& c = frame.camera;
+  c.fx /= n;
+  c.fy /= n;
+  c.cx /= n;
+  c.cy /= n;
+  c.width = frame.depth.cols;
+  c.height = frame.depth.rows;
 }
 
 Progress::Progress(std::string what, size_t total)

@@ -44,6 +44,10 @@ struct Frame {
   Camera camera;
 };
 
+// Every n-th row and column of the frame (depth, colour and labels, nearest neighbour: no new values), with
+// the intrinsics scaled to match: the scene as a sensor with n times fewer pixels per axis sees it.
+void subsample(Frame& frame, int n);
+
 // INPUT may be a depth PNG, an organized PCD, a dataset folder (SPEC Sec. 3) or a folder of PCDs.
 class FrameSource {
  public:

@@ -2,17 +2,17 @@
 # Writes the synthetic Table II families (paper Table II: boxes, stacked boxes, occluded, cylinders,
 # mixed, complex) as one labelled dataset whose scenes.json names each frame's family, so that
 # `clutterseg eval OUT` prints one row per family.
-#   scripts/synth_table2.sh OUT [FRAMES=20] [SEED=11] [SENSOR=kinect-v1]
+#   scripts/synth_table2.sh OUT [FRAMES=20] [SEED=11] [SENSOR=kinect-v1] [SIZE=640x480]
 set -euo pipefail
-out=${1:?usage: scripts/synth_table2.sh OUT [FRAMES] [SEED] [SENSOR]}
-frames=${2:-20}; seed=${3:-11}; sensor=${4:-kinect-v1}
+out=${1:?usage: scripts/synth_table2.sh OUT [FRAMES] [SEED] [SENSOR] [SIZE]}
+frames=${2:-20}; seed=${3:-11}; sensor=${4:-kinect-v1}; size=${5:-640x480}
 cli=${CLUTTERSEG:-$(dirname "$0")/../build/clutterseg}
 families="boxes stacked-boxes occluded cylinders mixed complex"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 mkdir -p "$tmp/all/depth" "$tmp/all/label" "$tmp/all/color"
 entries=()
 for f in $families; do
-  "$cli" synth --preset "$f" --frames "$frames" --seed "$seed" --sensor "$sensor" --out "$tmp/$f" >/dev/null
+  "$cli" synth --preset "$f" --frames "$frames" --seed "$seed" --sensor "$sensor" --size "$size" --out "$tmp/$f" >/dev/null
   for d in "$tmp/$f"/depth/*.png; do
     n=$(basename "$d" .png)
     for k in depth label color; do

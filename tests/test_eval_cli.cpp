@@ -183,6 +183,40 @@ TEST(EvalCli, SweepPrintsATablePerValueAndMarksTheBest) {
   fs::remove_all(tmp);
 }
 
+// --subsample 2 scores a 640x480 set as a 320x240 sensor sees it: depth, labels and intrinsics halved, the
+// scene still segmented, and the command in the summary says how the figures were made.
+TEST(EvalCli, SubsampleScoresTheSceneAtTheSmallerSize) {
+  const fs::path tmp = fresh_dir("subsample");
+  scenes::TestScene s = scenes::box_on_plane();
+  s.camera = synth::default_camera(640, 480);
+  const synth::Rendering rendering = s.render();
+  const fs::path ds = tmp / "ds";
+  fs::create_directories(ds / "depth");
+  write_camera_json(ds / "camera.json", s.camera);
+  cv::Mat mm;
+  rendering.depth.convertTo(mm, CV_16U, 1000.0);
+  cv::imwrite((ds / "depth" / "000000.png").string(), mm);
+  write_labels(ds / "label" / "000000.png", rendering.labels);
+
+  for (const int n : {1, 2}) {
+    const fs::path out = tmp / ("o" + std::to_string(n));
+    const CliRun r = run_cli("eval " + ds.string() + " --subsample " + std::to_string(n) + " --out " + out.string(), tmp);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(slurp(out / "summary.json"));
+    const auto& all = group(summary["runs"][0], "all");
+    EXPECT_EQ(all["failed"], 0);
+    EXPECT_GE(all["scores"]["tp"]["mean"].get<double>(), 0.9) << "n = " << n;
+    EXPECT_LE(all["scores"]["fp"]["mean"].get<double>(), 0.05) << "n = " << n;
+    EXPECT_EQ(summary["command"].get<std::string>().find("--subsample 2") != std::string::npos, n == 2);
+    // The boundary tolerance follows the scored image's size (0.3 % of its diagonal, rounded up).
+    EXPECT_EQ(summary["boundary_tolerance_px"].get<int>(), n == 1 ? 3 : 2);
+  }
+  const CliRun r = run_cli("eval " + ds.string() + " --pred " + (ds / "label").string() + " --subsample 2", tmp);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("cannot be combined with --subsample"), std::string::npos) << r.err;
+  fs::remove_all(tmp);
+}
+
 TEST(EvalCli, BadInputsAreOneLineErrors) {
   const fs::path tmp = fresh_dir("errors");
   const fs::path ds = tiny_dataset(tmp / "ds");
