@@ -99,7 +99,7 @@ struct BinnedPixels {
   BinnedPixels(const Patch& patch, int bins, const cv::Mat& points, const NormalPlanes& normals) {
     const auto* pts = points.ptr<cv::Vec3f>();
     const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>();
-    const size_t stride = std::max<size_t>(1, patch.pixels.size() / kBinnedSamples);
+    const size_t stride = std::max<size_t>(1, patch.pixels.size() / sample_budget(kBinnedSamples, points));
     std::vector<int> sampled, bin_of;
     start.assign(static_cast<size_t>(bins * bins) + 1, 0);
     for (size_t k = 0; k < patch.pixels.size(); k += stride) {
@@ -204,7 +204,7 @@ constexpr size_t kCentreSamples = 256;  // pixels used at most for a patch's cen
 CurvatureCentre curvature_centre(const Patch& patch, const cv::Mat& points, const NormalPlanes& normals) {
   const auto* pts = points.ptr<cv::Vec3f>();
   const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
-  const size_t stride = std::max<size_t>(1, patch.pixels.size() / kCentreSamples);
+  const size_t stride = std::max<size_t>(1, patch.pixels.size() / sample_budget(kCentreSamples, points));
   Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> sample;
@@ -256,7 +256,7 @@ int convexity(const Patch& patch, const cv::Mat& points, const NormalPlanes& nor
   // One pass of first and second moments; large patches are subsampled on a fixed stride.
   const auto* pts = points.ptr<cv::Vec3f>();
   const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
-  const size_t stride = std::max<size_t>(1, patch.pixels.size() / kConvexitySamples);
+  const size_t stride = std::max<size_t>(1, patch.pixels.size() / sample_budget(kConvexitySamples, points));
   Eigen::Vector3d sn = Eigen::Vector3d::Zero(), sp = Eigen::Vector3d::Zero();
   Eigen::Matrix3d snn = Eigen::Matrix3d::Zero(), snp = Eigen::Matrix3d::Zero(), spp = Eigen::Matrix3d::Zero();
   double count = 0;

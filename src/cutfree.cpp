@@ -33,7 +33,7 @@ bool one_side_of(const Patch& cutter, const Patch& other, const cv::Mat& points,
                  const Params::CutFree& params, std::uint64_t seed) {
   if (cutter.pixels.size() < 3 || other.pixels.empty() || params.planes <= 0) return true;
   std::vector<Eigen::Vector3f> samples;
-  const size_t stride = std::max<size_t>(1, other.pixels.size() / kMaxSamples);
+  const size_t stride = std::max<size_t>(1, other.pixels.size() / sample_budget(kMaxSamples, points));
   for (size_t i = 0; i < other.pixels.size(); i += stride) {
     const Eigen::Vector3f q = point_at(points, other.pixels[i]);
     if (q.z() > 0) samples.push_back(q);

@@ -39,7 +39,7 @@ CLUTTERSEG_ROW_KERNEL void deinterleave(const float* __restrict xyz, int n, floa
 // Extent of the valid points of `pixels` (a stride of at most ~2000) along the unit `direction` [m].
 float length_along(const std::vector<int>& pixels, const cv::Mat& points, const Eigen::Vector3f& direction) {
   const auto* pts = points.ptr<cv::Vec3f>();
-  const size_t stride = std::max<size_t>(1, pixels.size() / 2000);
+  const size_t stride = std::max<size_t>(1, pixels.size() / sample_budget(2000, points));
   float low = std::numeric_limits<float>::infinity(), high = -low;
   for (size_t k = 0; k < pixels.size(); k += stride) {
     const cv::Vec3f& q = pts[pixels[k]];
@@ -249,6 +249,7 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
   // Pixels of every other object, visited with a stride (bounded work per object).
   std::vector<Heights> heights(objects.size());
   std::vector<int> countdown(objects.size(), 0);
+  const int samples_per_object = static_cast<int>(sample_budget(kSamplesPerObject, points));
   const auto visit = [&](int o, int i) {
     const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
     const float d = support.plane.distance(q);
@@ -260,7 +261,7 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
   };
   for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
     if (objects[static_cast<size_t>(o)].support) return;
-    const int stride = std::max(1, objects[static_cast<size_t>(o)].pixel_count / kSamplesPerObject);
+    const int stride = std::max(1, objects[static_cast<size_t>(o)].pixel_count / samples_per_object);
     int& wait = countdown[static_cast<size_t>(o)];
     if (count_valid(&pts[begin][0], end - begin) == end - begin) {  // the common case: every stride-th pixel
       int i = begin + wait;

@@ -139,6 +139,17 @@ TEST(Reliability, PixelScaleIsCappedWhateverTheFocalLength) {
   }
 }
 
+// Per-patch statistics read a bounded sample: VGA's budget in any larger frame, a share of it in a smaller
+// one (a quarter at 320x240, never less), and never zero.
+TEST(Reliability, PerPatchSamplesAreBoundedWhateverTheFrameSize) {
+  EXPECT_EQ(sample_budget(2000, 640 * 480), 2000u);
+  EXPECT_EQ(sample_budget(2000, 320 * 240), 500u);
+  EXPECT_EQ(sample_budget(2000, 64 * 48), 500u);
+  EXPECT_EQ(sample_budget(2000, 4096 * 4096), 2000u);
+  EXPECT_EQ(sample_budget(2000, 480 * 360), 1125u);
+  EXPECT_EQ(sample_budget(1, 320 * 240), 1u);
+}
+
 TEST(Reliability, ConfigValuesAreTypeAndRangeCheckedNamingTheKey) {
   const fs::path tmp = fresh_dir("rel-config");
   const fs::path depth = kBad / "depth-64x48.png";

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -93,6 +94,17 @@ inline int first_zero(const std::uint8_t* bytes, int from, int end) {
   while (from < end && bytes[from]) ++from;
   return from;
 }
+
+// The most pixels a per-patch statistic reads (a RANSAC sample, a share, a fit): `vga` in a 640x480 frame,
+// and in a smaller frame that many times its share of VGA's pixels (a quarter at 320x240, never less), so
+// that every frame samples the scene as densely and a smaller frame spends proportionally less per patch,
+// as the per-pixel stages do. Larger frames keep the VGA budget: work per patch stays bounded.
+inline size_t sample_budget(size_t vga, size_t frame_pixels) {
+  constexpr size_t kVga = 640 * 480;
+  const size_t pixels = std::clamp(frame_pixels, kVga / 4, kVga);
+  return std::max<size_t>(1, vga * pixels / kVga);
+}
+inline size_t sample_budget(size_t vga, const cv::Mat& image) { return sample_budget(vga, image.total()); }
 
 // Checks intrinsics against an image; throws Error("<what>: ...") when they do not fit.
 void check_camera(const Camera& camera, int width, int height, const std::string& what);
