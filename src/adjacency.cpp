@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 #include <type_traits>
 
@@ -129,16 +130,17 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   cv::Mat has_depth(patch_labels.size(), CV_8U), near_depth;
   mark_depth(&pts[0][0], total, has_depth.ptr<uchar>());
   cv::dilate(has_depth, near_depth, cv::Mat());
-  std::vector<int> role(static_cast<size_t>(total));
-  std::vector<uchar> carrier(static_cast<size_t>(total));
-  mark_roles(lab, has_depth.ptr<uchar>(), near_depth.ptr<uchar>(), total, num_patches, kSource, kNeither, role.data(),
-             carrier.data());
+  // Every element is written by mark_roles: no zeroing (1.5 MB per 640x480 frame).
+  const auto role = std::make_unique_for_overwrite<int[]>(static_cast<size_t>(total));
+  const auto carrier = std::make_unique_for_overwrite<uchar[]>(static_cast<size_t>(total));
+  mark_roles(lab, has_depth.ptr<uchar>(), near_depth.ptr<uchar>(), total, num_patches, kSource, kNeither, role.get(),
+             carrier.get());
   struct Carrier {
     int i;
     std::int16_t x, y;
   };
   std::vector<Carrier> carriers;
-  for (int i = first_nonzero(carrier.data(), 0, total); i < total; i = first_nonzero(carrier.data(), i + 1, total)) {
+  for (int i = first_nonzero(carrier.get(), 0, total); i < total; i = first_nonzero(carrier.get(), i + 1, total)) {
     role[static_cast<size_t>(i)] = static_cast<int>(carriers.size());
     carriers.push_back({i, static_cast<std::int16_t>(i % width), static_cast<std::int16_t>(i / width)});
   }
