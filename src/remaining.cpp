@@ -193,8 +193,9 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       };
       if (x >= 2 && y >= 2 && x + 2 < width && y + 2 < height) {
         for (int k = 0; k < 8; ++k) grow(i + offset[k], grow2);
-        for (int k = 8; k < 16; ++k)
-          if (!valid_point(pts[i + offset[k - 8]])) grow(i + offset[k], grow2 * 4.f);
+        for (int k = 8; k < 16; ++k)  // its state first: one byte, and mostly not remaining
+          if (state[static_cast<size_t>(i + offset[k])] == kRemaining && !valid_point(pts[i + offset[k - 8]]))
+            grow(i + offset[k], grow2 * 4.f);
         continue;
       }
       for (int k = 0; k < 16; ++k) {
