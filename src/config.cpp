@@ -16,7 +16,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Normals, step_px, smooth
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Edges, theta, step_px, jump_slope)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Patches, min_size_px, histogram_bins, occupied_share, flat_max_bins, split_band, seam_theta, seam_spread_deg)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Adjacency, radius_px, d_max)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::CutFree, enabled, planes, band, wrong_side_fraction, skip_angle_deg, skip_similar)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::CutFree, enabled, planes, band, wrong_side_fraction, skip_angle_deg, skip_similar,
+                                                split_share)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Convexity, enabled, tolerance, step, concave_weight, step_offset)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Coplanarity, enabled, angle_deg, triples, lines, behind_fraction, behind_tolerance, lines_pass, max_gap)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Curvature, enabled, theta_h, open_objects, occluded, line_fit, neighbour_gap_px, concentric)

@@ -3,6 +3,9 @@
 // each other (each lies behind the other's plane).
 #include "clutterseg/cutfree.hpp"
 
+#include "clutterseg/patches.hpp"
+#include "clutterseg/support.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -92,6 +95,54 @@ std::vector<PatchPair> cut_free_pairs(const std::vector<PatchPair>& adjacent,
       kept.emplace_back(a, b);
   }
   return kept;
+}
+
+int split_cut_patches(cv::Mat& edges, const std::vector<PatchPair>& adjacent, const std::vector<PatchPair>& linked,
+                      const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
+                      const Params::CutFree& params, int min_px, const Eigen::Vector3f& up) {
+  if (params.split_share <= 0) return 0;
+  const auto* pts = points.ptr<cv::Vec3f>();
+  std::vector<std::uint8_t> split(patches.size(), 0);  // a patch is split once, at the first plane that cuts it
+  cv::Mat below;  // pixels of the patches to split behind the cutting plane; made for the first split
+  int marked = 0;
+  // Whether `cutter`'s plane cuts `other` in two; marks other's far side in `below` if so.
+  const auto cut = [&](const Patch& cutter, const Patch& other) {
+    // Only a top face (within 30 deg of up) splits a side face (within 30 deg of vertical): an object
+    // rests on a top. A box's side plane cuts the front of the box it stands on too (the front goes on
+    // past it), but that front is one face.
+    constexpr float kTopCos = 0.866f, kSideCos = 0.5f;
+    if (cutter.mean_normal.dot(up) < kTopCos || std::abs(other.mean_normal.dot(up)) > kSideCos) return;
+    if (static_cast<double>(other.pixels.size()) < 2.0 * min_px) return;
+    Plane plane;
+    if (!fit_plane(cutter.pixels, points, plane) || !mostly_within(cutter.pixels, points, plane, params.band, 0.9)) return;
+    const size_t stride = std::max<size_t>(1, other.pixels.size() / sample_budget(2000, points));
+    int above = 0, behind = 0, valid = 0;
+    for (size_t k = 0; k < other.pixels.size(); k += stride) {
+      const cv::Vec3f& q = pts[other.pixels[k]];
+      if (!valid_point(q)) continue;
+      const float d = plane.distance({q[0], q[1], q[2]}), tolerance = plane_tolerance(params.band, q[2]);
+      ++valid;
+      above += d > tolerance;
+      behind += d < -tolerance;
+    }
+    if (valid == 0 || std::min(above, behind) < params.split_share * valid) return;
+    if (below.empty()) below = cv::Mat(patch_labels.size(), CV_8U, cv::Scalar(0));
+    for (int i : other.pixels)
+      if (valid_point(pts[i]) && plane.distance({pts[i][0], pts[i][1], pts[i][2]}) < 0) {
+        below.ptr<uchar>()[i] = 255;
+        ++marked;
+      }
+    split[static_cast<size_t>(other.id - 1)] = 1;
+  };
+  for (const PatchPair& pair : adjacent) {
+    if (std::binary_search(linked.begin(), linked.end(), pair)) continue;
+    const Patch& a = patches[static_cast<size_t>(pair.first)];
+    const Patch& b = patches[static_cast<size_t>(pair.second)];
+    if (!split[static_cast<size_t>(pair.second)]) cut(a, b);
+    if (!split[static_cast<size_t>(pair.first)]) cut(b, a);
+  }
+  if (marked > 0) separate_marked(edges, below, patch_labels);
+  return marked;
 }
 
 }  // namespace clutterseg

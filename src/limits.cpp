@@ -60,6 +60,7 @@ void validate(const Params& p) {
   above("cutfree.band", p.cutfree.band, 0, 1);
   in_range("cutfree.wrong_side_fraction", p.cutfree.wrong_side_fraction, 0, 1);
   in_range("cutfree.skip_angle_deg", p.cutfree.skip_angle_deg, 0, 180);
+  in_range("cutfree.split_share", p.cutfree.split_share, 0, 0.5);
   in_range("convexity.tolerance", p.convexity.tolerance, 0, 2);
   in_range("convexity.step", p.convexity.step, 0, 1);
   in_range("convexity.concave_weight", p.convexity.concave_weight, 0, 1);

@@ -264,4 +264,22 @@ Patches update_patches(Patches previous, const cv::Mat& edges, const cv::Mat& de
   return build_patches(edges, depth, camera, normals, params, min_size, &previous);
 }
 
+void separate_marked(cv::Mat& edges, const cv::Mat& mark_image, const cv::Mat& patch_labels) {
+  if (mark_image.size() != patch_labels.size() || mark_image.type() != CV_8U || edges.size() != patch_labels.size())
+    throw Error("separate_marked: mark and edges must be CV_8U images of the patch image's size");
+  const uchar* mark = mark_image.ptr<uchar>();
+  const int* lab = patch_labels.ptr<int>();
+  uchar* edge = edges.ptr<uchar>();
+  const int width = patch_labels.cols, height = patch_labels.rows;
+  for (int y = 0; y < height; ++y)
+    // Marked pixels are few: the rest of a row is skipped eight at a time.
+    for (int x = first_nonzero(mark + y * width, 0, width); x < width; x = first_nonzero(mark + y * width, x + 1, width)) {
+      const int i = y * width + x;
+      const int neighbours[4] = {x > 0 ? i - 1 : -1, x + 1 < width ? i + 1 : -1, y > 0 ? i - width : -1,
+                                 y + 1 < height ? i + width : -1};
+      for (int j : neighbours)
+        if (j >= 0 && !mark[j] && lab[j] == lab[i]) edge[i] = edge[j] = 255;
+    }
+}
+
 }  // namespace clutterseg

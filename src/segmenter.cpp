@@ -119,24 +119,33 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
                                                               table, p.support) : 0) +                                // planes,
                   split_at_seams(r.edges, r.patches, r.core_patch_labels, r.edge_value, r.normals, p.patches,  // or of two
                                  px.area(p.patches.min_size_px), r.points, table, p.support);                  // faces
-  if (cut > 0) {  // measure again only the patches the cuts went through
+  const auto remeasure = [&] {  // measure again only the patches the cuts went through
     patches = update_patches({r.core_patch_labels, std::move(r.patches)}, r.edges, r.depth, camera, r.normals,
                              p.patches, px.area(p.patches.min_size_px));
     r.core_patch_labels = patches.labels;
     r.patches = std::move(patches.patches);
     mark_table();
-  }
+  };
+  if (cut > 0) remeasure();
   watch.mark("support");
-  const int num_patches = static_cast<int>(r.patches.size());
-  Assignment assignment = assign_edge_pixels(r.core_patch_labels, r.points, num_patches,   // d) adjacency
-                                             px.length(p.adjacency.radius_px), p.adjacency.d_max);
-  if (table) release_from_table(assignment.labels, r.core_patch_labels, r.patches, r.points, *table, p.support);
+  Assignment assignment;
+  std::vector<PatchPair> adjacent, links;
+  for (int round = 0; round < 2; ++round) {  // again once a patch two objects share is split (beyond the paper)
+    assignment = assign_edge_pixels(r.core_patch_labels, r.points, static_cast<int>(r.patches.size()),  // d) adjacency
+                                    px.length(p.adjacency.radius_px), p.adjacency.d_max);
+    if (table) release_from_table(assignment.labels, r.core_patch_labels, r.patches, r.points, *table, p.support);
+    adjacent = without_table_links(assignment.adjacent, r.patches);
+    watch.mark("assignment");
+    links = p.cutfree.enabled ? cut_free_pairs(adjacent, r.patches, r.points, p.cutfree, p.seed) : adjacent;  // e) cut-free
+    const bool split = round == 0 && p.cutfree.enabled &&
+                       split_cut_patches(r.edges, adjacent, links, r.patches, r.core_patch_labels, r.points, p.cutfree,
+                                         px.area(p.patches.min_size_px), table ? table->normal : up_in_camera(camera)) > 0;
+    if (split) remeasure();
+    watch.mark("cutfree");
+    if (!split) break;
+  }
   r.patch_labels = assignment.labels;
-  const std::vector<PatchPair> adjacent = without_table_links(assignment.adjacent, r.patches);
-  watch.mark("assignment");
-  const std::vector<PatchPair> links = p.cutfree.enabled                                  // e) cut-free
-      ? cut_free_pairs(adjacent, r.patches, r.points, p.cutfree, p.seed) : adjacent;
-  watch.mark("cutfree");
+  const int num_patches = static_cast<int>(r.patches.size());
   const std::vector<PairJunction> junctions = p.convexity.enabled                         // convex or concave
       ? classify_junctions(assignment.contacts, r.points, r.normals, p.convexity, r.patches) : std::vector<PairJunction>{};
   watch.mark("convexity");

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "clutterseg/parallel.hpp"
+#include "clutterseg/patches.hpp"
 
 namespace clutterseg {
 
@@ -460,27 +461,6 @@ int unmark_curved_table(std::vector<Patch>& patches, const Params::Support& para
   return unmarked;
 }
 
-namespace {
-
-// Where a marked pixel meets an unmarked pixel of its patch, both become edge pixels: the two parts are
-// no longer 4-connected.
-void separate_marked(cv::Mat& edges, const cv::Mat& mark_image, const cv::Mat& patch_labels) {
-  const uchar* mark = mark_image.ptr<uchar>();
-  const int* lab = patch_labels.ptr<int>();
-  uchar* edge = edges.ptr<uchar>();
-  const int width = patch_labels.cols, height = patch_labels.rows;
-  for (int y = 0; y < height; ++y)
-    // Marked pixels are few: the rest of a row is skipped eight at a time.
-    for (int x = first_nonzero(mark + y * width, 0, width); x < width; x = first_nonzero(mark + y * width, x + 1, width)) {
-      const int i = y * width + x;
-      const int neighbours[4] = {x > 0 ? i - 1 : -1, x + 1 < width ? i + 1 : -1, y > 0 ? i - width : -1,
-                                 y + 1 < height ? i + width : -1};
-      for (int j : neighbours)
-        if (j >= 0 && !mark[j] && lab[j] == lab[i]) edge[i] = edge[j] = 255;
-    }
-}
-
-}  // namespace
 
 namespace {
 

@@ -137,3 +137,75 @@ TEST(CutFree, SameSeedSameResult) {
   const auto b = cut_free_pairs(s.adjacent, s.result.patches, s.result.points, p, 7);
   EXPECT_EQ(a, b);
 }
+
+namespace {
+
+// Two stacked boxes seen from the front, built point by point in a camera looking down 45 degrees: the
+// upper box's front (rows 0-9) stands 8 mm behind the lower box's front (rows 13-29) and 1-4 cm above
+// the lower box's top (rows 10-12, patch 1). The fronts are one patch (2), joined at the left end
+// (columns 0-2 of rows 10-12), as a gap in the edge band joins them in stacked-boxes-000000.
+struct ForkedFronts {
+  cv::Mat points, labels;
+  std::vector<Patch> patches;
+  Eigen::Vector3f up;
+};
+
+ForkedFronts forked_fronts(bool cutter_is_a_side = false) {
+  const Eigen::Vector3f up = Eigen::Vector3f(0, -1, -1).normalized(), toward = Eigen::Vector3f(0, 1, -1).normalized(),
+                        right = Eigen::Vector3f::UnitX(), origin(0, 0, 1);
+  const auto at = [&](float x, float height, float back) { return Eigen::Vector3f(origin + x * right + height * up - back * toward); };
+  constexpr int kSize = 30;
+  ForkedFronts f{cv::Mat(kSize, kSize, CV_32FC3), cv::Mat(kSize, kSize, CV_32S, cv::Scalar(0)), {}, up};
+  f.patches.resize(2);
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      const float u = 0.004f * static_cast<float>(x);
+      Eigen::Vector3f q;
+      int label = 2;
+      if (y < 10) q = at(u, 0.04f - 0.003f * static_cast<float>(y), 0.008f);          // upper front
+      else if (y < 13 && x < 3) q = at(u, 0.f, 0.004f);                                // the joint
+      else if (y < 13) q = at(u, 0.f, 0.003f * static_cast<float>(y - 10)), label = 1;  // lower top
+      else q = at(u, -0.003f * static_cast<float>(y - 12), 0.f);                        // lower front
+      f.points.at<cv::Vec3f>(y, x) = {q.x(), q.y(), q.z()};
+      f.labels.at<int>(y, x) = label;
+      f.patches[static_cast<size_t>(label - 1)].pixels.push_back(y * kSize + x);
+    }
+  for (int k = 0; k < 2; ++k) f.patches[static_cast<size_t>(k)].id = k + 1;
+  f.patches[0].mean_normal = cutter_is_a_side ? Eigen::Vector3f(-right) : up;
+  f.patches[1].mean_normal = toward;
+  return f;
+}
+
+// The parts of patch `id` left 4-connected after `edges` are taken out.
+int parts_of(const cv::Mat& labels, const cv::Mat& edges, int id) {
+  cv::Mat inside = (labels == id) & (edges == 0), components;
+  return cv::connectedComponents(inside, components, 4) - 1;
+}
+
+}  // namespace
+
+TEST(CutFree, ATopCutsTheStackedFrontsPatchInTwo) {
+  ForkedFronts f = forked_fronts();
+  cv::Mat edges(f.labels.size(), CV_8U, cv::Scalar(0));
+  ASSERT_EQ(parts_of(f.labels, edges, 2), 1);
+  const Params::CutFree params;
+  const int marked = split_cut_patches(edges, {{0, 1}}, {}, f.patches, f.labels, f.points, params, 20, f.up);
+  EXPECT_GT(marked, 0);
+  EXPECT_EQ(parts_of(f.labels, edges, 2), 2);  // the upper front apart from the lower one
+  EXPECT_EQ(parts_of(f.labels, edges, 1), 1);  // the top is not touched
+}
+
+TEST(CutFree, NoSplitWhenLinkedNotATopOrSwitchedOff) {
+  const auto marked = [](const ForkedFronts& f, const std::vector<PatchPair>& linked, const Params::CutFree& params) {
+    cv::Mat edges(f.labels.size(), CV_8U, cv::Scalar(0));
+    const int n = split_cut_patches(edges, {{0, 1}}, linked, f.patches, f.labels, f.points, params, 20, f.up);
+    EXPECT_EQ(n == 0, cv::countNonZero(edges) == 0);
+    return n;
+  };
+  const Params::CutFree params;
+  EXPECT_EQ(marked(forked_fronts(), {{0, 1}}, params), 0);  // the pair passed the cut-free test
+  EXPECT_EQ(marked(forked_fronts(true), {}, params), 0);     // a side's plane cuts a front that goes on past it
+  Params::CutFree off;
+  off.split_share = 0;
+  EXPECT_EQ(marked(forked_fronts(), {}, off), 0);
+}

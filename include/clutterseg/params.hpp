@@ -68,6 +68,11 @@ struct Params {
                                        // share of the smaller patch [-]
     double skip_angle_deg = 30;  // pairs with mean normals closer than this skip the test (the authors' choice)
     bool skip_similar = true;    // set false to always test
+    double split_share = 0.15;   // beyond the paper: a side face that the plane of a flat top it failed
+                                 // this test with cuts into two parts, each at least this share of it
+                                 // beyond +-band (two stacked boxes' fronts joined around the thin top
+                                 // between them), is split at that plane and d) and e) run again [-];
+                                 // 0 = off
   } cutfree;
 
   // Beyond the paper: convex or concave junctions between adjacent patches (contact.hpp). A concave

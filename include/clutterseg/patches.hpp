@@ -25,6 +25,11 @@ Patches extract_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera
 Patches update_patches(Patches previous, const cv::Mat& edges, const cv::Mat& depth, const Camera& camera,
                        const NormalPlanes& normals, const Params::Patches& params, int min_size);
 
+// Where a marked pixel (mark: CV_8U, non-zero) meets an unmarked pixel of its patch, both become edge
+// pixels in `edges`: the marked and unmarked parts of a patch are no longer 4-connected, and
+// update_patches makes them patches of their own. The cuts of support.hpp, seams.hpp and cutfree.hpp.
+void separate_marked(cv::Mat& edges, const cv::Mat& mark, const cv::Mat& patch_labels);
+
 // One run of a connected component along an image row: columns [x0, x1) of row y.
 struct LabelRun {
   int component, y, x0, x1;

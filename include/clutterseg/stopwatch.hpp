@@ -7,14 +7,21 @@
 
 namespace clutterseg {
 
-// Records the time since the previous mark under a stage name; total() appends "total".
+// Records the time since the previous mark under a stage name (added to the stage's earlier time when a
+// stage runs again in the same frame); total() appends "total".
 class Stopwatch {
  public:
   explicit Stopwatch(Timings& out) : out_(out), start_(Clock::now()), last_(start_) {}
   void mark(const char* stage) {
     const auto now = Clock::now();
-    out_.emplace_back(stage, std::chrono::duration<double, std::milli>(now - last_).count());
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
     last_ = now;
+    for (auto& [name, time] : out_)
+      if (name == stage) {
+        time += ms;
+        return;
+      }
+    out_.emplace_back(stage, ms);
   }
   void total() { out_.emplace_back("total", std::chrono::duration<double, std::milli>(Clock::now() - start_).count()); }
 
