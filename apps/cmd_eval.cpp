@@ -165,7 +165,10 @@ void run_over_frames(const Evaluation& ev, const MethodFactory& make, RunRecord&
         throw Error(frame.path.string() + ": " + e.what());
       }
       rec.scores = score_frame(frame.label, out.labels);
-      rec.errors = error_breakdown(frame.label, out.labels, rec.scores.matches);
+      // The depth tells which lost pixels no depth-only method could place (a --pred run scores labels of
+      // any size: the figure is left out where the depth does not fit them).
+      rec.errors = error_breakdown(frame.label, out.labels, rec.scores.matches,
+                                   frame.depth.size() == frame.label.size() ? frame.depth : cv::Mat());
       tracking.add(frame.label, out.labels);
       report.boundary_tolerance_px = boundary_tolerance_px(frame.label.size());  // one camera per set
       for (const auto& [stage, ms] : out.timings_ms) {

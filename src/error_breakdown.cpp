@@ -20,14 +20,19 @@ cv::Mat int_labels(const cv::Mat& image, const char* what) {
 
 }  // namespace
 
-std::array<double, 10> breakdown_values(const ErrorBreakdown& b) {
-  return {b.kept, b.boundary, b.dropped, b.split, b.merged, b.correct, b.boundary_p, b.background, b.merged_p, b.extra};
+std::array<double, 11> breakdown_values(const ErrorBreakdown& b) {
+  return {b.kept, b.boundary, b.dropped, b.split, b.merged, b.no_depth, b.correct, b.boundary_p, b.background, b.merged_p, b.extra};
 }
 
 ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& prediction,
-                               const std::vector<std::pair<int, int>>& matches) {
+                               const std::vector<std::pair<int, int>>& matches, const cv::Mat& depth) {
   const cv::Mat gt = int_labels(ground_truth, "ground truth"), pred = int_labels(prediction, "prediction");
   if (gt.size() != pred.size()) throw Error("error breakdown: the ground truth and the prediction differ in size");
+  if (!depth.empty() && (depth.size() != gt.size() || depth.channels() != 1 || (depth.depth() != CV_16U && depth.depth() != CV_32F)))
+    throw Error("error breakdown: the depth image must be one channel of uint16 or float of the labels' size");
+  // 255 where there is no measurement (0, or NaN for float depth: NaN > 0 is false).
+  cv::Mat unmeasured;
+  if (!depth.empty()) unmeasured = depth.depth() == CV_16U ? (depth == 0) : ~(depth > 0);
   std::unordered_map<int, int> pred_of_gt, gt_of_pred;
   for (const auto& [g, p] : matches) {
     pred_of_gt[g] = p;
@@ -39,7 +44,7 @@ ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& predi
   cv::dilate(object_boundaries(gt), band, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * radius + 1, 2 * radius + 1}),
              cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
 
-  enum { kKept, kBoundary, kDropped, kSplit, kMerged, kCorrect, kBoundaryP, kBackground, kMergedP, kExtra, kCount };
+  enum { kKept, kBoundary, kDropped, kSplit, kMerged, kCorrect, kBoundaryP, kBackground, kMergedP, kExtra, kNoDepth, kCount };
   std::array<long, kCount> count{};
   std::map<std::pair<int, int>, long> overlap;  // (gt id, pred id) -> pixels: bounded by the pixels
   std::map<int, long> gt_area;
@@ -51,12 +56,15 @@ ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& predi
     const int* g = gt.ptr<int>(y);
     const int* p = pred.ptr<int>(y);
     const uchar* near_boundary = band.ptr<uchar>(y);
+    const uchar* no_measurement = unmeasured.empty() ? nullptr : unmeasured.ptr<uchar>(y);
     for (int x = 0; x < gt.cols; ++x) {
       if (g[x] != 0) {  // where a ground-truth pixel went
         ++gt_area[g[x]];
         if (p[x] != 0) ++overlap[{g[x], p[x]}];
         const int own = matched(pred_of_gt, g[x]);
-        if (own != 0 && p[x] == own) ++count[kKept];
+        const bool kept = own != 0 && p[x] == own;
+        if (!kept && no_measurement && no_measurement[x]) ++count[kNoDepth];
+        if (kept) ++count[kKept];
         else if (near_boundary[x]) ++count[kBoundary];
         else if (p[x] == 0) ++count[kDropped];
         else if (matched(gt_of_pred, p[x]) != 0) ++count[kMerged];
@@ -81,6 +89,7 @@ ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& predi
     b.dropped = count[kDropped] / gt_pixels;
     b.split = count[kSplit] / gt_pixels;
     b.merged = count[kMerged] / gt_pixels;
+    if (!unmeasured.empty()) b.no_depth = count[kNoDepth] / gt_pixels;
     // An empty prediction has no precision to lose (score_frame gives it P = 0 by convention).
     b.correct = b.boundary_p = b.background = b.merged_p = b.extra = 0;
   }

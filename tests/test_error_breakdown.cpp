@@ -5,6 +5,9 @@
 
 #include "clutterseg/error_breakdown.hpp"
 
+#include <cmath>
+#include <limits>
+
 using namespace clutterseg;
 
 namespace {
@@ -92,4 +95,23 @@ TEST(ErrorBreakdown, EmptyPredictionDropsEverythingAndHasNoPrecisionToLose) {
   EXPECT_DOUBLE_EQ(b.dropped + b.boundary, 1);
   EXPECT_DOUBLE_EQ(b.correct, 0);
   EXPECT_EQ(b.missed_objects, 1);
+}
+
+TEST(ErrorBreakdown, LostPixelsWithoutDepthAreCountedBesideTheirCause) {
+  const cv::Mat gt = with(blank(), cv::Rect(10, 10, 40, 20), 1);  // 800 px
+  cv::Mat pred = with(blank(), cv::Rect(10, 10, 40, 20), 1);
+  pred(cv::Rect(20, 15, 5, 5)).setTo(0);  // 25 px dropped, well inside the object
+  cv::Mat depth(gt.size(), CV_16U, cv::Scalar(1000));
+  depth(cv::Rect(20, 15, 5, 2)).setTo(0);  // 10 of them without depth
+  depth(cv::Rect(30, 15, 5, 5)).setTo(0);  // and 25 kept pixels without depth: not lost, not counted
+  const ErrorBreakdown b = error_breakdown(gt, pred, score_frame(gt, pred).matches, depth);
+  EXPECT_DOUBLE_EQ(b.dropped, 25.0 / 800);
+  EXPECT_DOUBLE_EQ(b.no_depth, 10.0 / 800);
+  expect_shares_sum_to_one(b);  // the partition is unchanged
+  cv::Mat metres;
+  depth.convertTo(metres, CV_32F, 0.001);
+  metres.setTo(std::numeric_limits<float>::quiet_NaN(), depth == 0);  // float depth: NaN = none
+  EXPECT_DOUBLE_EQ(error_breakdown(gt, pred, score_frame(gt, pred).matches, metres).no_depth, 10.0 / 800);
+  EXPECT_TRUE(std::isnan(error_breakdown(gt, pred, score_frame(gt, pred).matches).no_depth));
+  EXPECT_THROW(error_breakdown(gt, pred, score_frame(gt, pred).matches, depth(cv::Rect(0, 0, 50, 50))), Error);
 }

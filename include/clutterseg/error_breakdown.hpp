@@ -19,6 +19,9 @@ struct ErrorBreakdown {
   double dropped = kNaN;    // in no segment (label 0)
   double split = kNaN;      // in a segment matched to no object (an extra piece of it)
   double merged = kNaN;     // in the segment of another object (merged into it)
+  double no_depth = kNaN;   // of the above but kept: the pixels without a depth measurement (not a cause of
+                            // its own, a share of all ground-truth object pixels as well): what no depth-only
+                            // method can place, the limit of Overlap R; NaN when no depth image is given
   // Predicted object pixels (shares sum to 1): what each covers.
   double correct = kNaN;          // its segment's matched object (Overlap P)
   double boundary_p = kNaN;       // elsewhere, but within the boundary tolerance
@@ -31,14 +34,15 @@ struct ErrorBreakdown {
   int missed_objects = 0;   // objects with no matched segment
 };
 
-inline constexpr std::array<const char*, 10> kBreakdownNames = {
-    "kept", "boundary", "dropped", "split", "merged", "correct", "boundary_p", "background", "merged_p", "extra"};
-std::array<double, 10> breakdown_values(const ErrorBreakdown& b);
+inline constexpr std::array<const char*, 11> kBreakdownNames = {
+    "kept", "boundary", "dropped", "split", "merged", "no_depth", "correct", "boundary_p", "background", "merged_p", "extra"};
+std::array<double, 11> breakdown_values(const ErrorBreakdown& b);
 
 // The breakdown of one image, given the one-to-one matching of score_frame (FrameScores::matches):
 // pixels within boundary_tolerance_px of a ground-truth object boundary that are wrong count as
-// boundary errors whatever else they are. Images as for score_frame.
+// boundary errors whatever else they are. Images as for score_frame; `depth` (optional, CV_16U or CV_32F
+// of the same size, 0 or NaN = no measurement) gives ErrorBreakdown::no_depth.
 ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& prediction,
-                               const std::vector<std::pair<int, int>>& matches);
+                               const std::vector<std::pair<int, int>>& matches, const cv::Mat& depth = cv::Mat());
 
 }  // namespace clutterseg
