@@ -21,7 +21,7 @@ import re, sys
 stages = ["median_depth", "TemporalSmoother::push", "depth_to_points", "compute_normals", "normal_edge_value",
           "edge_mask", "extract_patches", "assign_edge_pixels", "cut_free_pairs", "coplanar_pairs",
           "curvature_links", "cut_graph", "assign_remaining", "describe_objects", "find_support_plane", "cut_off_table",
-          "split_at_planes", "split_at_seams", "split_cut_patches", "release_from_table", "classify_junctions", "classify_objects", "support_of"]
+          "split_at_planes", "split_at_seams", "split_cut_patches", "release_from_table", "claim_enclosed_floors", "classify_junctions", "classify_objects", "support_of"]
 cost, inside = {}, False
 for line in sys.stdin:
     m = re.match(r"\s*([\d,]+) \([^)]*\)\s+(\*|>)\s+\S*?clutterseg::([\w:]+)\(.*?\((\d+)x\)", line)

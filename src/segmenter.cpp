@@ -171,6 +171,8 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   r.object_labels = assign_remaining(r.patch_labels, parts.object_of_node,                       // j) remaining
                                      static_cast<int>(parts.cut_cost.size()), r.points, r.normals, p.remaining,
                                      px.area(p.remaining.tiny_px), table_hint, &occlusion);
+  if (table) claim_enclosed_floors(r.object_labels, r.patch_labels, r.patches, parts.object_of_node,  // a pan's floor
+                                   px.length(p.adjacency.radius_px), px.length(2), p.support.enclosed_share);
   watch.mark("remaining");
   r.objects = describe_objects(r.object_labels, r.points, parts.object_of_node, parts.cut_cost, camera);  // objects
   r.support_plane = table;

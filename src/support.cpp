@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <span>
 #include <opencv2/imgproc.hpp>
@@ -661,6 +662,58 @@ int settle_table(std::vector<Patch>& patches, const std::vector<std::pair<int, i
   for (int& o : object_of_patch) o = new_id[static_cast<size_t>(o)];
   cut_cost = std::move(kept);
   return absorbed;
+}
+
+int claim_enclosed_floors(cv::Mat& object_labels, const cv::Mat& patch_labels, std::vector<Patch>& patches,
+                          std::vector<int>& object_of_patch, int reach_px, int ring_px, double share) {
+  if (share <= 0 || ring_px <= 0) return 0;
+  if (object_labels.type() != CV_32S || patch_labels.type() != CV_32S || object_labels.size() != patch_labels.size() ||
+      object_of_patch.size() != patches.size())
+    throw Error("claim_enclosed_floors: CV_32S object and patch images of one size and one object per patch expected");
+  int largest = -1;
+  for (int p = 0; p < static_cast<int>(patches.size()); ++p)
+    if (patches[static_cast<size_t>(p)].table &&
+        (largest < 0 || patches[static_cast<size_t>(p)].pixels.size() > patches[static_cast<size_t>(largest)].pixels.size()))
+      largest = p;
+  if (largest < 0) return 0;
+  const int table_label = object_of_patch[static_cast<size_t>(largest)] + 1;
+  const cv::Rect image(0, 0, patch_labels.cols, patch_labels.rows);
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, {2 * ring_px + 1, 2 * ring_px + 1});  // separable: fast
+  int claimed = 0;
+  for (int p = 0; p < static_cast<int>(patches.size()); ++p) {
+    Patch& patch = patches[static_cast<size_t>(p)];
+    if (!patch.table || p == largest) continue;
+    // The patch's box grown by the edge pixels it took (within reach_px of its core) and the ring: inside the image.
+    const int grow = reach_px + ring_px + 1;
+    const cv::Rect box(patch.bbox.x - grow, patch.bbox.y - grow, patch.bbox.width + 2 * grow, patch.bbox.height + 2 * grow);
+    if ((box & image) != box) continue;
+    const cv::Mat region = patch_labels(box) == patch.id;
+    cv::Mat ring;
+    cv::dilate(region, ring, kernel);
+    ring &= ~region;
+    std::map<int, int> count;  // object label -> ring pixels
+    int ring_pixels = 0, unlabelled = 0;
+    for (int y = 0; y < box.height; ++y) {
+      const uchar* in_ring = ring.ptr<uchar>(y);
+      const int* label = object_labels.ptr<int>(box.y + y) + box.x;
+      for (int x = 0; x < box.width; ++x) {
+        if (!in_ring[x]) continue;
+        ++ring_pixels;
+        if (label[x] == 0) ++unlabelled;
+        else ++count[label[x]];
+      }
+    }
+    const int labelled = ring_pixels - unlabelled;
+    if (ring_pixels == 0 || 2 * labelled < ring_pixels) continue;
+    const auto owner = std::max_element(count.begin(), count.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+    if (owner == count.end() || owner->first == table_label || owner->second < share * labelled) continue;
+    cv::Mat labels = object_labels(box);
+    labels.setTo(owner->first, region & (labels == table_label));
+    patch.table = false;
+    object_of_patch[static_cast<size_t>(p)] = owner->first - 1;
+    ++claimed;
+  }
+  return claimed;
 }
 
 Support support_of(const Plane& plane, const std::vector<Patch>& patches, const cv::Mat& points,

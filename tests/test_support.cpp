@@ -134,3 +134,59 @@ TEST(Support, ACurvedPatchInTheBandIsNoTable) {
   EXPECT_FALSE(patches[2].table);
   EXPECT_FALSE(patches[3].table);
 }
+
+namespace {
+
+// A 60x60 frame: table (patch 1, object 1) everywhere but a disc of radius 10 at (30, 30), a second table
+// patch (2: a pan's floor in the table's band), inside a rim of object 2 (radius 10 to 14) that stage j)
+// made; `rim_share` of the rim, from the left, is that object's, the rest table.
+struct Floor {
+  cv::Mat object_labels, patch_labels;
+  std::vector<Patch> patches;
+  std::vector<int> object_of_patch{0, 0};
+};
+
+Floor pan_floor(double rim_share, cv::Point centre = {30, 30}) {
+  Floor f{cv::Mat(60, 60, CV_32S, cv::Scalar(1)), cv::Mat(60, 60, CV_32S, cv::Scalar(1)), {}};
+  std::vector<int> table, floor;
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 60; ++x) {
+      const double r = std::hypot(x - centre.x, y - centre.y);
+      const bool rim = r >= 10 && r < 14 && x - (centre.x - 14) < rim_share * 28;
+      if (r < 10) {
+        f.patch_labels.at<int>(y, x) = 2;
+        floor.push_back(y * 60 + x);
+      } else {
+        if (rim) f.object_labels.at<int>(y, x) = 2, f.patch_labels.at<int>(y, x) = 0;
+        else table.push_back(y * 60 + x);
+      }
+    }
+  f.patches = {patch_with(1, table, true, {0, 0, 60, 60}),
+               patch_with(2, floor, true, {centre.x - 9, centre.y - 9, 19, 19})};
+  return f;
+}
+
+}  // namespace
+
+TEST(Support, AFloorInsideARimThatStageJMadeJoinsTheRim) {
+  Floor f = pan_floor(1.0);
+  EXPECT_EQ(claim_enclosed_floors(f.object_labels, f.patch_labels, f.patches, f.object_of_patch, 2, 2, 0.8), 1);
+  EXPECT_FALSE(f.patches[1].table);
+  EXPECT_EQ(f.object_of_patch[1], 1);
+  EXPECT_EQ(f.object_labels.at<int>(30, 30), 2);  // the floor is the rim's object
+  EXPECT_EQ(f.object_labels.at<int>(2, 2), 1);    // the table is still the table
+  EXPECT_TRUE(f.patches[0].table);
+}
+
+TEST(Support, AFloorNotEnclosedByOneObjectStaysTable) {
+  const auto claimed = [](Floor f, double share) {
+    const cv::Mat before = f.object_labels.clone();
+    const int n = claim_enclosed_floors(f.object_labels, f.patch_labels, f.patches, f.object_of_patch, 2, 2, share);
+    EXPECT_EQ(n == 0, cv::countNonZero(before != f.object_labels) == 0);
+    return n;
+  };
+  EXPECT_EQ(claimed(pan_floor(0.6), 0.8), 0);               // table on 40 % of its rim: a piece of table
+  EXPECT_EQ(claimed(pan_floor(1.0, {12, 30}), 0.8), 0);     // the ring reaches the image border
+  EXPECT_EQ(claimed(pan_floor(1.0), 0), 0);                 // switched off
+  EXPECT_EQ(claimed(pan_floor(0.9), 0.8), 1);               // 80 % of the rim and more: enclosed
+}

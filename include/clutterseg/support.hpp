@@ -125,6 +125,19 @@ int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, con
 int settle_table(std::vector<Patch>& patches, const std::vector<std::pair<int, int>>& adjacent,
                  std::vector<int>& object_of_patch, std::vector<float>& cut_cost);
 
+// Beyond the paper, after stage j): settle_table's enclosed floors, judged by pixels. A flat floor inside a
+// bowl or a pan seen from above lies within the table's band, and when the wall around it has no patch
+// (a thin rim: only edge band) the floor is adjacent to the table across the rim and stays table; stage j)
+// then makes the rim an object of its own. A table patch other than the largest whose surroundings (the
+// ring of ring_px pixels around the pixels it holds in patch_labels, which lie within reach_px of its core
+// pixels: stage d's radius) are at least half labelled and, of
+// the labelled pixels, at least `share` one object's that is not the table's, is that object's floor: its
+// table-labelled pixels take that object's label, Patch::table is cleared and object_of_patch points to
+// the object. A ring that touches the image border never encloses. Returns the patches claimed; share 0 =
+// off.
+int claim_enclosed_floors(cv::Mat& object_labels, const cv::Mat& patch_labels, std::vector<Patch>& patches,
+                          std::vector<int>& object_of_patch, int reach_px, int ring_px, double share);
+
 // The support with its visible region: the hull of all table patches.
 Support support_of(const Plane& plane, const std::vector<Patch>& patches, const cv::Mat& points,
                    const Params::Support& params);
