@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 namespace clutterseg {
@@ -103,6 +104,8 @@ int split_cut_patches(cv::Mat& edges, const std::vector<PatchPair>& adjacent, co
   if (params.split_share <= 0) return 0;
   const auto* pts = points.ptr<cv::Vec3f>();
   std::vector<std::uint8_t> split(patches.size(), 0);  // a patch is split once, at the first plane that cuts it
+  std::vector<std::optional<std::optional<Plane>>> top_plane(patches.size());  // per cutter, fitted once: a flat
+                                                                              // top's plane, or none
   cv::Mat below;  // pixels of the patches to split behind the cutting plane; made for the first split
   int marked = 0;
   // Whether `cutter`'s plane cuts `other` in two; marks other's far side in `below` if so.
@@ -113,8 +116,14 @@ int split_cut_patches(cv::Mat& edges, const std::vector<PatchPair>& adjacent, co
     constexpr float kTopCos = 0.866f, kSideCos = 0.5f;
     if (cutter.mean_normal.dot(up) < kTopCos || std::abs(other.mean_normal.dot(up)) > kSideCos) return;
     if (static_cast<double>(other.pixels.size()) < 2.0 * min_px) return;
-    Plane plane;
-    if (!fit_plane(cutter.pixels, points, plane) || !mostly_within(cutter.pixels, points, plane, params.band, 0.9)) return;
+    auto& fitted = top_plane[static_cast<size_t>(cutter.id - 1)];
+    if (!fitted) {
+      Plane flat;
+      const bool is_flat = fit_plane(cutter.pixels, points, flat) && mostly_within(cutter.pixels, points, flat, params.band, 0.9);
+      fitted = is_flat ? std::optional<Plane>(flat) : std::nullopt;
+    }
+    if (!*fitted) return;
+    const Plane& plane = **fitted;
     const size_t stride = std::max<size_t>(1, other.pixels.size() / sample_budget(2000, points));
     int above = 0, behind = 0, valid = 0;
     for (size_t k = 0; k < other.pixels.size(); k += stride) {

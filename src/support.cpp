@@ -462,7 +462,6 @@ int unmark_curved_table(std::vector<Patch>& patches, const Params::Support& para
   return unmarked;
 }
 
-
 namespace {
 
 // The pixels of `pixels` (valid points) farther from `plane` than plane_tolerance(band, z), on either side.
