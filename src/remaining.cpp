@@ -11,8 +11,9 @@
 // - "Enclosed" = the segment does not touch the image border or another remaining segment, and the
 //   face holds at least half of its ring of neighbour pixels; the rest may be invalid pixels (the
 //   shadow a Kinect casts beside every small object must not make it part of the table).
-// - Beyond the paper: a segment grows across single pixels without depth (a Kinect drops pixels all over
-//   a face seen at a grazing angle, which would leave it in specks, each "tiny" and "without a face").
+// - Beyond the paper: a segment grows across runs of up to Params::Remaining::gap_px pixels without depth
+//   (a Kinect drops pixels all over a face seen at a grazing angle, which would leave it in specks, each
+//   "tiny" and "without a face"), with grow_distance per pixel step: never across a depth jump.
 // - Beyond the paper: in rule 5 a segment that is a face of its own (its mean normal more than 30 deg from
 //   every neighbouring face's local plane: the narrow side of a box seen edge-on) joins, whole, the face it
 //   meets in a convex edge (n_s - n_f) . (c_s - c_f) > 0, as faces of one object meet, not the table or
@@ -59,9 +60,9 @@ struct Segment {
   cv::Rect bbox;
 };
 
-// States of a pixel: still to grow, grown into a segment, in the segment being looked at; plus a bit
-// for the ring pixels of that segment.
-constexpr uchar kRemaining = 1, kGrown = 2, kInSegment = 3, kInRing = 0x80;
+// States of a pixel: no patch and no depth (the growing crosses it), a patch pixel, still to grow, grown into
+// a segment, in the segment being looked at; plus a bit for the ring pixels of that segment.
+constexpr uchar kNoDepth = 0, kFace = 1, kRemaining = 2, kGrown = 3, kInSegment = 4, kInRing = 0x80;
 
 // The first pixel at or after `from` still to grow (state.size() if none). memchr: the remaining pixels
 // are few and scattered, and it scans many bytes per step.
@@ -70,8 +71,8 @@ int next_remaining(const std::vector<uchar>& state, int from) {
   return static_cast<int>(found ? found - state.data() : static_cast<std::ptrdiff_t>(state.size()));
 }
 
-// Object id of every pixel (obj) and the remaining pixels: no patch but a valid point (state =
-// kRemaining; `state` comes zeroed). Returns their count; *max_label = the largest label seen. Labels come
+// Object id of every pixel (obj) and the state of every pixel: kFace, kRemaining (no patch but a valid
+// point) or kNoDepth. Returns their count; *max_label = the largest label seen. Labels come
 // in long runs (a patch's row segments): one lookup and one fill per run, and the depth is read only in
 // runs of label 0 (edge bands and holes: a small share of the image).
 int mark_remaining(const int* __restrict lab, const float* __restrict xyz, const int* __restrict object_of_label,
@@ -84,9 +85,11 @@ int mark_remaining(const int* __restrict lab, const float* __restrict xyz, const
     if (l == 0)
       for (int i = begin; i < end; ++i) {
         const bool remaining = valid_depth(xyz[3 * i + 2]);
-        state[i] = remaining ? kRemaining : 0;
+        state[i] = remaining ? kRemaining : kNoDepth;
         count += remaining;
       }
+    else
+      std::memset(state + begin, kFace, static_cast<size_t>(end - begin));
     begin = end;
   }
   *max_label = largest;
@@ -136,7 +139,7 @@ bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, con
 cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
                          int num_objects, const cv::Mat& points, const NormalPlanes& normals,
                          const Params::Remaining& params, int tiny_px, const std::optional<TableHint>& table,
-                         const OcclusionCheck* occlusion) {
+                         const OcclusionCheck* occlusion, int gap_px) {
   if (assigned_labels.type() != CV_32S || points.type() != CV_32FC3 || assigned_labels.size() != points.size())
     throw Error("assign_remaining: labels must be CV_32S and points CV_32FC3 of the same size");
   const bool have_normals = !normals[0].empty();
@@ -158,7 +161,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   for (int p = 0; p < num_patches; ++p) object_of_label[static_cast<size_t>(p) + 1] = object_of_patch[static_cast<size_t>(p)] + 1;
   cv::Mat objects(assigned_labels.size(), CV_32S);
   int* obj = objects.ptr<int>();
-  // Remaining pixels (no patch, valid) are marked once, so the growing below reads one byte per pixel.
+  // Every pixel's state is marked once, so the growing below reads one byte per pixel.
   std::vector<uchar> state(static_cast<size_t>(total), 0);
   int max_label = 0;
   const auto num_remaining = static_cast<size_t>(
@@ -171,8 +174,11 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   const float grow2 = static_cast<float>(params.grow_distance * params.grow_distance);
   std::vector<int> pixels;
   pixels.reserve(num_remaining);
-  int offset[16];  // of the 16 pixels looked at from a pixel, as index differences
-  for (int k = 0; k < 16; ++k) offset[k] = (k < 8 ? 1 : 2) * (kDy[k % 8] * width + kDx[k % 8]);
+  int offset[8];  // of the 8 neighbours, as index differences
+  for (int k = 0; k < 8; ++k) offset[k] = kDy[k] * width + kDx[k];
+  const int reach = 1 + std::max(0, gap_px);  // steps along a direction: the neighbour, then across the gap
+  std::vector<float> limit2(static_cast<size_t>(reach) + 1);  // grow_distance per pixel step
+  for (int s = 1; s <= reach; ++s) limit2[static_cast<size_t>(s)] = grow2 * static_cast<float>(s * s);
   for (int seed_px = next_remaining(state, 0); seed_px < total; seed_px = next_remaining(state, seed_px + 1)) {
     const size_t begin = pixels.size();
     pixels.push_back(seed_px);
@@ -182,29 +188,25 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const int i = pixels[head];
       const int x = i % width, y = i / width;
       x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
-      // The 8 neighbours, then the pixels two steps away across a neighbour without depth, in the order of
-      // `offset`. Pixels two or more steps inside the image need no border test (most of them).
-      const auto grow = [&](int j, float limit2) {
-        if (state[static_cast<size_t>(j)] != kRemaining) return;
-        const cv::Vec3f d = pts[i] - pts[j];
-        if (d.dot(d) >= limit2) return;
-        state[static_cast<size_t>(j)] = kGrown;
-        pixels.push_back(j);
-      };
-      if (x >= 2 && y >= 2 && x + 2 < width && y + 2 < height) {
-        for (int k = 0; k < 8; ++k) grow(i + offset[k], grow2);
-        for (int k = 8; k < 16; ++k)  // its state first: one byte, and mostly not remaining
-          if (state[static_cast<size_t>(i + offset[k])] == kRemaining && !valid_point(pts[i + offset[k - 8]]))
-            grow(i + offset[k], grow2 * 4.f);
-        continue;
-      }
-      for (int k = 0; k < 16; ++k) {
-        const int step = k < 8 ? 1 : 2;
-        const int xx = x + step * kDx[k % 8], yy = y + step * kDy[k % 8];
-        if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
-        if (step == 2 && valid_point(pts[i + offset[k - 8]])) continue;
-        grow(yy * width + xx, grow2 * static_cast<float>(step * step));
-      }
+      // Along each of the 8 directions: the neighbour, and beyond it while the pixels passed have no depth
+      // (at most gap_px of them). Pixels `reach` steps inside the image need no border test (most of them).
+      const bool inside = x >= reach && y >= reach && x + reach < width && y + reach < height;
+      for (int k = 0; k < 8; ++k)
+        for (int s = 1, j = i + offset[k]; s <= reach; ++s, j += offset[k]) {
+          if (!inside) {
+            const int xx = x + s * kDx[k], yy = y + s * kDy[k];
+            if (xx < 0 || yy < 0 || xx >= width || yy >= height) break;
+          }
+          const uchar here = state[static_cast<size_t>(j)];
+          if (here == kRemaining) {
+            const cv::Vec3f d = pts[i] - pts[j];
+            if (d.dot(d) < limit2[static_cast<size_t>(s)]) {
+              state[static_cast<size_t>(j)] = kGrown;
+              pixels.push_back(j);
+            }
+          }
+          if (here != kNoDepth) break;  // only pixels without depth (and no patch) are crossed
+        }
     }
     segments.push_back({begin, pixels.size(), cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1)});
   }

@@ -170,7 +170,8 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   const OcclusionCheck occlusion{camera, p.coplanarity.behind_tolerance, p.coplanarity.behind_fraction};
   r.object_labels = assign_remaining(r.patch_labels, parts.object_of_node,                       // j) remaining
                                      static_cast<int>(parts.cut_cost.size()), r.points, r.normals, p.remaining,
-                                     px.area(p.remaining.tiny_px), table_hint, &occlusion);
+                                     px.area(p.remaining.tiny_px), table_hint, &occlusion,
+                                     p.remaining.gap_px > 0 ? px.length(p.remaining.gap_px) : 0);
   if (table) claim_enclosed_floors(r.object_labels, r.patch_labels, r.patches, parts.object_of_node,  // a pan's floor
                                    px.length(p.adjacency.radius_px), px.length(2), p.support.enclosed_share);
   watch.mark("remaining");

@@ -218,6 +218,28 @@ TEST(Remaining, ASegmentGrowsAcrossSinglePixelsWithoutDepth) {
   EXPECT_EQ(o.at<int>(6, 30), 2);
 }
 
+// Beyond the paper (Params::Remaining::gap_px): at a steeper grazing angle most pixels drop out (occluded-000016
+// of the Table II frames: a box side with one pixel in five); the growing crosses runs of up to gap_px
+// missing pixels, so the specks stay one face, but never across a depth jump.
+TEST(Remaining, ASegmentGrowsAcrossRunsOfMissingPixelsUpToTheGap) {
+  Case c;
+  c.labels.colRange(0, 10).setTo(1);
+  c.depth.colRange(10, 40).setTo(0);
+  for (int y = 5; y < 20; y += 3)
+    for (int x = 20; x < 32; x += 3) c.depth.at<float>(y, x) = 0.8f;  // one pixel in nine: 20 specks
+  c.depth.at<float>(5, 35) = 0.9f;  // 3 px beyond the last speck of its row, but 10 cm deeper
+  const auto run = [&](int gap_px) {
+    return assign_remaining(c.labels, {0}, 1, c.points(), NormalPlanes{}, Params::Remaining{}, 5, {}, nullptr, gap_px);
+  };
+  const cv::Mat two = run(2);
+  EXPECT_EQ(two.at<int>(5, 20), 2);  // the specks: one segment of 20 px, a new object
+  EXPECT_EQ(two.at<int>(17, 29), 2);
+  EXPECT_EQ(two.at<int>(5, 35), 0);  // the deeper pixel is a speck of its own (below tiny_px): noise
+  const cv::Mat one = run(1);        // crossing single missing pixels only: 20 specks of 1 px, all noise
+  EXPECT_EQ(one.at<int>(5, 20), 0);
+  EXPECT_EQ(one.at<int>(17, 29), 0);
+}
+
 // Beyond the paper (holes.hpp): a pixel without depth takes the object that encloses it along a row or a
 // column, never the table's, never across two objects, and never beyond max_run.
 TEST(Remaining, HolesEnclosedByOneObjectJoinIt) {

@@ -19,7 +19,8 @@ struct TableHint {
 
 // object_of_patch maps 0-based patch index to 0-based object index. Returns the object image
 // (CV_32S, 1..M, 0 = no measurement, or an isolated segment smaller than tiny_px) after region-growing
-// the unassigned valid pixels (grow_distance in 3D per pixel step, across single missing pixels) and
+// the unassigned valid pixels (grow_distance in 3D per pixel step, across runs of at most gap_px pixels
+// without depth along the 8 directions; gap_px already scaled, 0 = 8-connected only) and
 // applying the paper's five rules; new objects get ids after the existing ones. A segment of several
 // objects' faces that is a face of its own (its normals differ from every neighbouring face's) joins the
 // face it meets in a convex edge, and a segment seen behind its one face across depth jumps larger than
@@ -30,6 +31,6 @@ struct TableHint {
 cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
                          int num_objects, const cv::Mat& points, const NormalPlanes& normals,
                          const Params::Remaining& params, int tiny_px, const std::optional<TableHint>& table = {},
-                         const OcclusionCheck* occlusion = nullptr);
+                         const OcclusionCheck* occlusion = nullptr, int gap_px = 1);
 
 }  // namespace clutterseg
