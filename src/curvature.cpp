@@ -392,9 +392,12 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   for (const auto& [i, j] : similar) {
     const auto& a = patches[static_cast<size_t>(i)];
     const auto& b = patches[static_cast<size_t>(j)];
-    // Open object: the outer (convex) and inner (concave) wall of a cup or bowl meet at the rim.
+    // Open object: the outer (convex) and inner (concave) wall of a cup or bowl meet at the rim, and share
+    // their centre of curvature (beyond the paper: two cans side by side, one read as concave, do not).
     if (p.open_objects && convexity_of(i) * convexity_of(j) == -1) {
-      if (neighbours(i, j)) {
+      const bool i_outer = convexity_of(i) > 0;
+      if (neighbours(i, j) &&
+          (p.open_centre <= 0 || concentric(centre_of(i_outer ? i : j), centre_of(i_outer ? j : i), p.open_centre))) {
         out.push_back({{i, j}, Cue::CurvatureOpen});
         continue;
       }

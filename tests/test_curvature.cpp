@@ -201,3 +201,53 @@ TEST(Curvature, ConcentricRuleLinksTheBowlWallsOnly) {
     EXPECT_EQ(added[0].cue, Cue::CurvatureOpen);
   }
 }
+
+// Beyond the paper (curvature.open_centre): the open-object rule's convex and concave walls must share their
+// centre of curvature. Two hand-made walls of radius 5 cm with the same normal histogram, image neighbours
+// 5 px apart: a cup's outside and inside about one axis are linked; a convex can beside a concave surface
+// whose axis lies 3 radii away (complex-000017: two cans, one read as concave) only with the test off.
+TEST(Curvature, OpenObjectRuleAsksTheWallsForOneAxis) {
+  const int h = 20, w = 60, gap = 5, cols = 2 * w + gap;
+  Camera camera;
+  camera.fx = camera.fy = 525;
+  camera.cx = cols / 2.0;
+  camera.cy = h / 2.0;
+  camera.width = cols;
+  camera.height = h;
+  const auto links_for = [&](float axis_offset, const Params& params) {
+    cv::Mat points(h, cols, CV_32FC3, cv::Scalar::all(0)), labels(h, cols, CV_32S, cv::Scalar(0));
+    NormalPlanes normals{cv::Mat(h, cols, CV_32F, cv::Scalar(0)), cv::Mat(h, cols, CV_32F, cv::Scalar(0)),
+                         cv::Mat(h, cols, CV_32F, cv::Scalar(0))};
+    std::vector<Patch> patches(2);
+    const float r = 0.05f, z0 = 1.f;
+    for (int k = 0; k < 2; ++k) {
+      const int side = k == 0 ? 1 : -1, first = k == 0 ? 0 : w + gap;  // outside, then inside
+      const float axis_x = k == 0 ? 0.f : axis_offset;
+      Patch& p = patches[static_cast<size_t>(k)];
+      p.id = k + 1;
+      p.curved = true;
+      p.bbox = cv::Rect(first, 0, w, h);
+      p.histogram.assign(121, 0.f);
+      for (int b = 0; b < 11; ++b) p.histogram[static_cast<size_t>(55 + b)] = 1.f / 11;  // one row of bins: alike
+      for (int v = 0; v < h; ++v)
+        for (int u = 0; u < w; ++u) {
+          const float a = (static_cast<float>(u) / (w - 1) - 0.5f) * static_cast<float>(M_PI / 3);
+          const int x = first + u;
+          points.at<cv::Vec3f>(v, x) = {axis_x + r * std::sin(a), 0.002f * static_cast<float>(v),
+                                         z0 - static_cast<float>(side) * r * std::cos(a)};
+          const Eigen::Vector3f n(static_cast<float>(side) * std::sin(a), 0, -std::cos(a));
+          for (int d = 0; d < 3; ++d) normals[static_cast<size_t>(d)].at<float>(v, x) = n(d);
+          labels.at<int>(v, x) = p.id;
+          p.pixels.push_back(v * cols + x);
+        }
+    }
+    return curvature_links(patches, {}, labels, points, normals, camera, params);
+  };
+  Params off;
+  off.curvature.open_centre = 0;
+  const auto cup = links_for(0.f, Params{});
+  ASSERT_EQ(cup.size(), 1u);
+  EXPECT_EQ(cup[0].cue, Cue::CurvatureOpen);
+  EXPECT_TRUE(links_for(0.15f, Params{}).empty());  // the inside's axis 3 radii from the outside's
+  ASSERT_EQ(links_for(0.15f, off).size(), 1u);      // the paper's rule alone links them
+}

@@ -19,7 +19,8 @@ struct CurvatureLink {
 };
 
 // Links between curved patches not already in `linked`: similar histograms (S > theta_h) and either
-// image neighbours of opposite convexity (open object), or a 3D line through both patches' peak-bin
+// image neighbours of opposite convexity whose centres of curvature agree within params.curvature.open_centre
+// (open object; the centre test is beyond the paper), or a 3D line through both patches' peak-bin
 // points that fits within line_fit and passes the occlusion check (occluded curved object). Beyond the
 // paper, image neighbours of opposite convexity whatever their histograms whose normals meet at one
 // centre or axis (params.curvature.concentric; an open object's outer wall and its inside).

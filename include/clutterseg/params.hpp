@@ -113,6 +113,9 @@ struct Params {
                                  // differ (a bowl's outer wall and its inside) are one open object when their
                                  // centres of curvature (sphere centre or cylinder axis) lie within this share
                                  // of the outer wall's radius [-]; 0 = off
+    double open_centre = 2.2;    // beyond the paper: the open-object rule's walls (similar histograms) must have
+                                 // their centres of curvature within this share of the outer wall's radius, as
+                                 // a cup's two walls do and two cylinders side by side do not [-]; 0 = off
   } curvature;
 
   // i) Graph cut on the patch graph: w_ij = 1/deg(i), symmetrised.
