@@ -432,11 +432,18 @@ std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const
     }
   }
   // Refit over every patch lying in the plane, twice: the second pass sees the pieces the first one's
-  // better plane brings within the tolerance.
+  // better plane brings within the tolerance. A refit that no longer holds the patch it started from is
+  // not the table seen better but pulled away by far pieces (their tolerance grows with depth, and far
+  // points tilt a least-squares plane most): the plane before it stays (tabletop-realsense 000008).
+  const Patch& seed = patches[static_cast<size_t>(candidates[static_cast<size_t>(best)])];
   Plane plane = planes[static_cast<size_t>(best)];
   for (int pass = 0; pass < 2; ++pass) {
     const std::vector<int> near = patches_near(patches, points, plane, params);
-    if (near.empty() || !refit(patches, near, points, params.plane_band, plane)) break;
+    Plane refitted = plane;
+    if (near.empty() || !refit(patches, near, points, params.plane_band, refitted) ||
+        !is_near(seed, points, refitted, params))
+      break;
+    plane = refitted;
   }
   return plane;
 }
