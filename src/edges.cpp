@@ -145,4 +145,20 @@ cv::Mat edge_mask(const cv::Mat& edge_value, const cv::Mat& depth, double theta,
   return edges;
 }
 
+double median_edge_value(const cv::Mat& edge_value, const cv::Mat& depth, int stride) {
+  CV_Assert(edge_value.type() == CV_32F && depth.type() == CV_32F && edge_value.size() == depth.size() && stride > 0);
+  std::vector<float> sample;
+  sample.reserve(static_cast<size_t>((edge_value.rows / stride + 1) * (edge_value.cols / stride + 1)));
+  for (int y = 0; y < edge_value.rows; y += stride) {
+    const float* v = edge_value.ptr<float>(y);
+    const float* z = depth.ptr<float>(y);
+    for (int x = 0; x < edge_value.cols; x += stride)
+      if (valid_depth(z[x])) sample.push_back(v[x]);
+  }
+  if (sample.empty()) return 1;
+  const auto middle = sample.begin() + static_cast<std::ptrdiff_t>(sample.size() / 2);
+  std::nth_element(sample.begin(), middle, sample.end());
+  return *middle;
+}
+
 }  // namespace clutterseg

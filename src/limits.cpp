@@ -42,6 +42,7 @@ void validate(const Params& p) {
   in_range("smoothing.scene_change_share", p.smoothing.scene_change_share, 0, 1);
   int_range("normals.step_px", p.normals.step_px, 1, 16);
   int_range("normals.smooth_ksize", p.normals.smooth_ksize, 1, 31);
+  in_range("normals.noise_floor", p.normals.noise_floor, 0, 1);
   if (p.normals.smooth_ksize % 2 == 0)
     throw Error("parameter 'normals.smooth_ksize' = " + std::to_string(p.normals.smooth_ksize) + ": must be odd");
   in_range("edges.theta", p.edges.theta, 0, 1);

@@ -92,9 +92,15 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
                                : temporal_.push(depth, p.smoothing);              // may be the caller's image
   watch.mark("temporal_smoothing");
   r.depth = depth;
-  r.normals = compute_normals(depth, camera, step, px.odd(p.normals.smooth_ksize), jump);  // a) normals
+  int ksize = px.odd(p.normals.smooth_ksize);
+  r.normals = compute_normals(depth, camera, step, ksize, jump);                 // a) normals
   watch.mark("normals");
   r.edge_value = normal_edge_value(r.normals, edge_step);                        // b) normal edges
+  if (p.normals.noise_floor > 0 && median_edge_value(r.edge_value, depth) < p.normals.noise_floor) {
+    ksize = 2 * ksize - 1;  // a noisy sensor: most of the scene would be edges (beyond the paper)
+    r.normals = compute_normals(depth, camera, step, ksize, jump);
+    r.edge_value = normal_edge_value(r.normals, edge_step);
+  }
   r.edges = edge_mask(r.edge_value, r.depth, p.edges.theta, pixel_jump);
   watch.mark("edges");
   Patches patches = extract_patches(r.edges, r.depth, camera, r.normals, p.patches,  // c) surface patches

@@ -26,6 +26,10 @@ struct Params {
   struct Normals {
     int step_px = 1;             // neighbour distance at 320x240 [px], scaled (PixelScale)
     int smooth_ksize = 5;        // Gaussian kernel at 320x240 [px, odd], scaled (PixelScale)
+    double noise_floor = 0.92;   // beyond the paper: when the median edge value (mean |n.n_q|, stage b) over the
+                                 // pixels with depth is below this, the normals are smoothed again with a
+                                 // kernel twice as wide: a noisy sensor (active stereo's correlated disparity
+                                 // noise) would make most of a smooth scene edges [-]; 0 = off
   } normals;
 
   // b) Normal edges.
