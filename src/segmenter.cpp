@@ -92,13 +92,14 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
                                : temporal_.push(depth, p.smoothing);              // may be the caller's image
   watch.mark("temporal_smoothing");
   r.depth = depth;
-  int ksize = px.odd(p.normals.smooth_ksize);
+  const int ksize = px.odd(p.normals.smooth_ksize);
   r.normals = compute_normals(depth, camera, step, ksize, jump);                 // a) normals
   watch.mark("normals");
   r.edge_value = normal_edge_value(r.normals, edge_step);                        // b) normal edges
   if (p.normals.noise_floor > 0 && median_edge_value(r.edge_value, depth) < p.normals.noise_floor) {
-    ksize = 2 * ksize - 1;  // a noisy sensor: most of the scene would be edges (beyond the paper)
-    r.normals = compute_normals(depth, camera, step, ksize, jump);
+    // A noisy sensor: most of the scene would be edges. Smoothed once more, twice as wide (beyond the
+    // paper; timed with the edges).
+    r.normals = compute_normals(depth, camera, step, 2 * ksize - 1, jump);
     r.edge_value = normal_edge_value(r.normals, edge_step);
   }
   r.edges = edge_mask(r.edge_value, r.depth, p.edges.theta, pixel_jump);
