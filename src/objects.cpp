@@ -213,6 +213,63 @@ void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo
   }
 }
 
+// Share of object `id`'s outline near its face (its label's ends along rows and columns, within
+// 4 * reach pixels of the face's bounding box) behind which, within `reach` pixels, the first measured
+// point is at least 10 % farther from the camera (sampled). A wall is the farthest surface in its direction:
+// beyond its outline lie the image border, no depth, another wall or something in front of it; a large
+// upright object (a laptop's lid) hides what is behind it. Outline pixels with nothing measured within
+// reach are not counted.
+float share_hiding_something(const std::vector<int>& face, int id, const cv::Mat& object_labels, const cv::Mat& points,
+                             int reach) {
+  constexpr float kFarther = 1.1f;
+  const int width = object_labels.cols, height = object_labels.rows;
+  int x0 = width, y0 = height, x1 = -1, y1 = -1;
+  for (int i : face) {
+    x0 = std::min(x0, i % width), x1 = std::max(x1, i % width);
+    y0 = std::min(y0, i / width), y1 = std::max(y1, i / width);
+  }
+  x0 = std::max(0, x0 - 4 * reach), y0 = std::max(0, y0 - 4 * reach);
+  x1 = std::min(width - 1, x1 + 4 * reach), y1 = std::min(height - 1, y1 + 4 * reach);
+  const int* lab = object_labels.ptr<int>();
+  const auto* pts = points.ptr<cv::Vec3f>();
+  static constexpr int kSteps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+  // A sample: every stride-th row and column (the same share at any resolution, a quarter of the work at VGA).
+  const int stride = std::max(1, reach / 4);
+  int seen = 0, hiding = 0;
+  for (int y = y0; y <= y1; y += stride)
+    for (int x = x0; x <= x1; x += stride) {
+      const int i = y * width + x;
+      if (lab[i] != id || !valid_point(pts[i])) continue;
+      for (const auto& [dx, dy] : kSteps) {
+        int xx = x + dx, yy = y + dy;
+        if (xx < 0 || yy < 0 || xx >= width || yy >= height || lab[yy * width + xx] == id) continue;  // inside
+        for (int k = 0; k < reach; ++k, xx += dx, yy += dy) {
+          if (xx < 0 || yy < 0 || xx >= width || yy >= height) break;
+          const int j = yy * width + xx;
+          if (lab[j] == id || !valid_point(pts[j])) continue;
+          ++seen;
+          hiding += pts[j][2] > kFarther * pts[i][2];
+          break;
+        }
+      }
+    }
+  return seen > 0 ? static_cast<float>(hiding) / static_cast<float>(seen) : 0.f;
+}
+
+// Share of (a sample of) the pixels less than `height` above the plane, those below it included.
+float share_lower_than(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double height) {
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / sample_budget(2000, points));
+  int low = 0, n = 0;
+  for (size_t k = 0; k < pixels.size(); k += stride) {
+    const cv::Vec3f& q = pts[pixels[k]];
+    if (!valid_point(q)) continue;
+    ++n;
+    low += plane.distance(Eigen::Vector3f(q[0], q[1], q[2])) < height;
+  }
+  return n > 0 ? static_cast<float>(low) / static_cast<float>(n) : 0.f;
+}
+
 }  // namespace
 
 std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat& points,
@@ -237,7 +294,7 @@ std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat
 }
 
 void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& patches, const cv::Mat& object_labels,
-                      const cv::Mat& points, const Support& support, const Params::Support& params) {
+                      const cv::Mat& points, const Support& support, const Params::Support& params, int reach_px) {
   if (object_labels.type() != CV_32S || points.type() != CV_32FC3 || object_labels.size() != points.size())
     throw Error("classify_objects: labels must be CV_32S and points CV_32FC3 of the same size");
   const auto* pts = points.ptr<cv::Vec3f>();
@@ -276,6 +333,15 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
     }
   });
   const Eigen::Vector3f up = support.plane.normal;
+  // Beyond the paper: an upright face standing on the table (its foot within contact distance) in front
+  // of something farther is an object, not a wall (a laptop's lid, a board); a wall above a ledge that
+  // hides the room behind does not stand on the table.
+  constexpr double kFootShare = 0.02;
+  const auto stands_in_front = [&](const std::vector<int>& face, int id) {
+    return params.wall_hides_share > 0 &&
+           share_lower_than(face, points, support.plane, params.contact_distance) >= kFootShare &&
+           share_hiding_something(face, id, object_labels, points, reach_px) >= params.wall_hides_share;
+  };
   for (size_t o = 0; o < objects.size(); ++o) {
     Object& object = objects[o];
     const Heights& h = heights[o];
@@ -294,7 +360,8 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
     Plane own;
     if (fit_plane(face, points, own) && mostly_within(face, points, own, params.plane_band, 0.9) &&
         std::abs(own.normal.dot(up)) < std::cos(60.0 * M_PI / 180.0) &&
-        length_along(face, points, up.cross(own.normal).normalized()) >= params.wall_min_extent)
+        length_along(face, points, up.cross(own.normal).normalized()) >= params.wall_min_extent &&
+        !stands_in_front(face, object.id))
       object.background = true;
   }
 }

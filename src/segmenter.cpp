@@ -186,7 +186,7 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   r.support_plane = table;
   if (table)                                                                     // table, walls
     classify_objects(r.objects, r.patches, r.object_labels, r.points, support_of(*table, r.patches, r.points, p.support),
-                     p.support);
+                     p.support, px.length(4));
   if (p.remaining.hole_px > 0)                                                   // pixels without depth
     fill_depth_holes(r.object_labels, r.depth, r.objects, px.length(p.remaining.hole_px),  // (beyond the paper)
                      camera.fx * p.remaining.shadow_baseline);

@@ -100,6 +100,14 @@ inline TestScene box_before_wall() {
   return s;
 }
 
+// An open laptop's lid: a thin upright board, 40 x 25 cm, standing on a table that shows behind it.
+// As flat, as upright and as long as box_before_wall()'s wall, but it stands on the table and hides it.
+inline TestScene board_on_table() {
+  TestScene s{{{table(), box(1, {0, 0, 0.125}, {0.2, 0.005, 0.125})}}};
+  s.world_to_camera = synth::look_at({0, -0.8, 0.7}, {0, 0.05, 0.05});
+  return s;
+}
+
 // Two boxes of equal height with table between them: co-planar tops separated by background
 // (paper Fig. 5, red box), which must not be joined.
 inline TestScene separate_boxes() {

@@ -87,6 +87,23 @@ TEST(Objects, WallIsBackgroundAndTheBoxIsKept) {
   EXPECT_GT(scenes::kept_share(view, truth.labels, 1, truth.depth), 0.95);
 }
 
+// Beyond the paper (support.wall_hides_share): pcl-organized's laptop lid was dropped as a wall.
+TEST(Objects, AnUprightBoardOnTheTableIsAnObjectNotAWall) {
+  const auto scene = scenes::board_on_table();
+  const auto truth = scene.render();
+  const Result r = run(scene, truth);
+  ASSERT_TRUE(r.support_plane.has_value());
+  const cv::Mat view = objects_only(r.object_labels, r.objects);
+  EXPECT_LT(scenes::kept_share(view, truth.labels, 0, truth.depth), 0.02);
+  EXPECT_GT(scenes::kept_share(view, truth.labels, 1, truth.depth), 0.9);
+  // Without the rule the board is a wall: the switch is what keeps it.
+  Params p;
+  p.smoothing.temporal = false;
+  p.support.wall_hides_share = 0;
+  const Result off = segment(truth.depth, scene.camera, p);
+  EXPECT_LT(scenes::kept_share(objects_only(off.object_labels, off.objects), truth.labels, 1, truth.depth), 0.1);
+}
+
 TEST(Objects, StackedBoxesStaySeparateAndSameInputGivesSameLabels) {
   const auto scene = scenes::stacked_boxes();
   const auto truth = scene.render();

@@ -17,9 +17,11 @@ std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat
 
 // Marks objects[i].support (it holds a table patch, Patch::table) and .background (walls and far
 // surfaces: mostly higher than max_height above the table or below it, mostly not over the table's
-// visible region, or a large flat object perpendicular to the table).
+// visible region, or a large flat object perpendicular to the table, unless it stands on the table in
+// front of a farther surface: Params::Support::wall_hides_share, looked for within reach_px pixels,
+// already scaled).
 void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& patches, const cv::Mat& object_labels,
-                      const cv::Mat& points, const Support& support, const Params::Support& params);
+                      const cv::Mat& points, const Support& support, const Params::Support& params, int reach_px);
 
 // Copy of object_labels with support and background objects set to 0 and the rest renumbered 1..K in
 // the order of their ids, or with their ids kept when keep_ids (tracked ids, Params::Tracking).
