@@ -20,7 +20,8 @@
 //   the object it stands against (a concave crease).
 // - Beyond the paper: a table face (TableHint) takes no pixel standing clear of the table's plane.
 // - Beyond the paper: in rules 2-3 a segment seen behind its one face across depth jumps (most of its
-//   contacts with it, Params::Remaining::occluded_jump) is an object that face hides, not a part of it.
+//   contacts with it, Params::Remaining::occluded_jump) is an object that face hides, not a part of it;
+//   behind the face's own edge band, left as a segment of its own, counts as behind the face.
 // - Beyond the paper: in rules 1-3 a segment that would be an object of its own (hidden behind its one face,
 //   or cut off from every face by missing depth) joins the object on whose nearby faces' planes it lies, with
 //   only nearer things between (the co-planarity cue f/g for a segment; Params::Remaining::hidden_coplanar_band).
@@ -213,7 +214,13 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
 
   int next_object = num_objects;
   std::vector<int> ring;                      // per segment: its ring pixels
-  std::vector<std::pair<int, int>> faces;     // per segment: (patch label, ring pixels)
+  // A neighbouring face of a segment: its ring pixels on the face, and (for a non-table face) how many of
+  // them lie across a depth jump with the segment behind, or not.
+  struct Face {
+    int label, ring = 0, behind = 0, touching = 0;
+    bool hides() const { return behind > kHiddenRatio * touching; }  // one of several faces; see the rule below
+  };
+  std::vector<Face> faces;  // per segment, sorted by label
   struct FacePlane {
     Plane plane;
     Eigen::Vector3f centroid;
@@ -292,7 +299,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     // segment is looked at, then unmarked: the work stays proportional to the segment).
     bool touches_border = false;
     int other_segment = 0, invalid = 0;
-    int behind = 0, touching = 0;  // ring pixels of a non-table face across a depth jump, the segment behind; or not
+    int behind_segment = 0;  // ring pixels of other segments across a depth jump, the segment behind
     faces.clear();
     ring.clear();
     for (int i : seg_pixels) state[static_cast<size_t>(i)] = kInSegment;
@@ -312,14 +319,19 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         state[static_cast<size_t>(j)] |= kInRing;
         ring.push_back(j);
         if (lab[j] > 0) {
+          auto face = std::find_if(faces.begin(), faces.end(), [&](const Face& f) { return f.label == lab[j]; });
+          if (face == faces.end()) face = faces.insert(faces.end(), Face{lab[j]});
+          ++face->ring;
           if (occluded_jump2 > 0 && !is_table(lab[j])) {
             const cv::Vec3f d = pts[i] - pts[j];
-            if (d.dot(d) > occluded_jump2 && pts[i][2] > pts[j][2]) ++behind; else ++touching;
+            if (d.dot(d) > occluded_jump2 && pts[i][2] > pts[j][2]) ++face->behind; else ++face->touching;
           }
-          auto it = std::find_if(faces.begin(), faces.end(), [&](const auto& f) { return f.first == lab[j]; });
-          if (it == faces.end()) faces.emplace_back(lab[j], 1); else ++it->second;
         } else if (state[static_cast<size_t>(j)] == (kGrown | kInRing)) {
           ++other_segment;
+          if (occluded_jump2 > 0 && valid_point(pts[j])) {  // e.g. the occluder's edge band that no patch took
+            const cv::Vec3f d = pts[i] - pts[j];
+            behind_segment += d.dot(d) > occluded_jump2 && pts[i][2] > pts[j][2];
+          }
         } else {
           ++invalid;
         }
@@ -327,13 +339,13 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     }
     for (int i : seg_pixels) state[static_cast<size_t>(i)] = kGrown;
     for (int j : ring) state[static_cast<size_t>(j)] &= static_cast<uchar>(~kInRing);
-    std::sort(faces.begin(), faces.end());  // by label: independent of the scan order
-    if (table && std::any_of(faces.begin(), faces.end(), [&](const auto& f) { return is_table(f.first); })) {
+    std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.label < b.label; });  // scan order free
+    if (table && std::any_of(faces.begin(), faces.end(), [&](const Face& f) { return is_table(f.label); })) {
       // A segment mostly clear of the table is not the table's, whatever else it touches.
       int clear = 0;
       for (int i : seg_pixels) clear += clear_of_table(pts[i]);
       if (2 * clear > static_cast<int>(seg_pixels.size()))
-        std::erase_if(faces, [&](const auto& f) { return is_table(f.first); });
+        std::erase_if(faces, [&](const Face& f) { return is_table(f.label); });
     }
     auto set_all = [&](int object_id) { for (int i : seg_pixels) obj[i] = object_id; };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
@@ -349,32 +361,47 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     }
     if (faces.size() == 1) {
       const bool tiny = static_cast<int>(seg_pixels.size()) < tiny_px;          // rule 2
-      const bool enclosed = !touches_border && other_segment == 0 && faces[0].second >= invalid;  // rule 3
+      const Face& face = faces[0];
+      const bool enclosed = !touches_border && other_segment == 0 && face.ring >= invalid;  // rule 3
       // Beyond the paper: seen behind its one face across depth jumps (most of its contacts), the segment is
-      // an object that face hides, not a part of it.
-      const bool hidden = behind > kHiddenRatio * touching && behind >= kHiddenRingShare * static_cast<double>(ring.size());
+      // an object that face hides, not a part of it. Behind the face's edge band (a segment of its own) counts
+      // as behind the face, once the face itself is seen in front somewhere.
+      const int seen_behind = face.behind > 0 ? face.behind + behind_segment : 0;
+      const bool hidden = seen_behind > kHiddenRatio * face.touching &&
+                          seen_behind >= kHiddenRingShare * static_cast<double>(ring.size());
       // Beyond the paper: hidden, it may be the far part of an object the face cuts in two (co-planarity, f/g).
       const int coplanar = !tiny && hidden && params.hidden_coplanar_band > 0
-          ? coplanar_object(seg_pixels, seg.bbox, object_of(faces[0].first)) : 0;
-      set_all(coplanar > 0 ? coplanar : !tiny && (enclosed || hidden) ? ++next_object : object_of(faces[0].first));
+          ? coplanar_object(seg_pixels, seg.bbox, object_of(face.label)) : 0;
+      set_all(coplanar > 0 ? coplanar : !tiny && (enclosed || hidden) ? ++next_object : object_of(face.label));
       continue;
     }
-    const int first_object = object_of(faces[0].first);
-    if (std::all_of(faces.begin(), faces.end(), [&](const auto& f) { return object_of(f.first) == first_object; })) {
+    // Beyond the paper: a face the segment is seen behind (most of their contacts across a jump) hides it and
+    // takes none of it; hidden behind every face, it is an object of its own (or of the far part's, as above).
+    const Face longest = *std::max_element(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.ring < b.ring; });
+    std::erase_if(faces, [](const Face& f) { return f.hides(); });
+    if (faces.empty()) {
+      const bool tiny = static_cast<int>(seg_pixels.size()) < tiny_px;
+      const int coplanar = !tiny && params.hidden_coplanar_band > 0
+          ? coplanar_object(seg_pixels, seg.bbox, object_of(longest.label)) : 0;
+      set_all(coplanar > 0 ? coplanar : !tiny ? ++next_object : object_of(longest.label));
+      continue;
+    }
+    const int first_object = object_of(faces[0].label);
+    if (std::all_of(faces.begin(), faces.end(), [&](const Face& f) { return object_of(f.label) == first_object; })) {
       set_all(first_object);                                          // rule 4
       continue;
     }
     // Rule 5: the local plane of every neighbouring face.
     planes.clear();
-    for (const auto& f : faces) {
+    for (const Face& f : faces) {
       Plane plane;
       Eigen::Vector3f centroid;
-      if (fit_plane_near(assigned_labels, points, f.first, seg.bbox, plane, centroid))
-        planes.push_back({plane, centroid, object_of(f.first), is_table(f.first)});
+      if (fit_plane_near(assigned_labels, points, f.label, seg.bbox, plane, centroid))
+        planes.push_back({plane, centroid, object_of(f.label), is_table(f.label)});
     }
     if (planes.empty()) {  // only degenerate faces: the face with the longest contact takes it
-      const auto best = std::max_element(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-      set_all(object_of(best->first));
+      const auto best = std::max_element(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.ring < b.ring; });
+      set_all(object_of(best->label));
       continue;
     }
     // A face of its own joins the face it meets in the most convex edge.

@@ -101,6 +101,46 @@ TEST(Remaining, ASegmentHiddenBehindItsOneFaceIsAnObjectOfItsOwn) {
   EXPECT_EQ(run(0.90f, 0.03), 1);  // in front of the face
 }
 
+// The same on real frames (occluded-000018, a lying cylinder cut by an upright one): the occluder's edge band
+// is a segment of its own between the face and the far part, which touches the face itself in two pixels
+// only. Seen behind the band, the far part is still hidden by the face, not a part of it.
+TEST(Remaining, ASegmentHiddenBehindItsFacesEdgeBandIsAnObjectOfItsOwn) {
+  const auto run = [](float z, double jump) {
+    Case c;
+    c.labels.colRange(0, 15).setTo(1);                  // the occluder's face
+    c.labels(cv::Rect(15, 4, 2, 1)).setTo(1);           // ... reaching the far part in one row
+    c.depth.colRange(17, 40).setTo(0);                  // its shadow and the void beyond
+    c.depth(cv::Rect(17, 4, 8, 23)).setTo(z);           // the far part, 184 px; columns 15-16: the edge band
+    Params::Remaining params;
+    params.occluded_jump = jump;
+    return assign_remaining(c.labels, {0}, 1, c.points(), NormalPlanes{}, params, 20);
+  };
+  const cv::Mat hidden = run(1.10f, 0.03);
+  EXPECT_EQ(hidden.at<int>(15, 20), 2);  // 10 cm behind the band: an object the face hides
+  EXPECT_EQ(hidden.at<int>(15, 15), 1);  // the band itself is the face's
+  EXPECT_EQ(run(1.10f, 0).at<int>(15, 20), 1);     // off: rule 3, joins the face
+  EXPECT_EQ(run(1.02f, 0.03).at<int>(15, 20), 1);  // 2 cm behind: within the jump, one surface with the face
+}
+
+// Rule 5 beyond the paper: a face the segment is seen behind (most contacts across a jump) takes none of it.
+// Between two nearer objects the segment is an object of its own (complex-000012: a cylinder's visible part
+// behind a lying box went to the box); seen continuing a farther face beside it, it joins that face's object.
+TEST(Remaining, AFaceTheSegmentIsSeenBehindTakesNoneOfIt) {
+  const auto run = [](float right_z, double jump) {
+    Case c;
+    c.labels.colRange(0, 15).setTo(1);                 // object 1, in front
+    c.labels.colRange(25, 40).setTo(2);                // object 2
+    c.depth.colRange(25, 40).setTo(right_z);
+    c.depth(cv::Rect(15, 0, 10, 30)).setTo(1.10f);     // the segment, 10 cm behind object 1
+    Params::Remaining params;
+    params.occluded_jump = jump;
+    return assign_remaining(c.labels, {0, 1}, 2, c.points(), NormalPlanes{}, params, 20).at<int>(15, 20);
+  };
+  EXPECT_EQ(run(1.0f, 0.03), 3);    // behind both: an object of its own
+  EXPECT_EQ(run(1.10f, 0.03), 2);   // on object 2's surface: object 2's
+  EXPECT_NE(run(1.0f, 0), 3);       // off: rule 5 gives it to a face's object by its plane
+}
+
 // Beyond the paper (Params::Remaining::hidden_coplanar_band): a box behind a nearer one, cut in two by it.
 // Its right part is a face (object 2), its left part a segment with no patch (too small and too far for
 // one), hidden behind the occluder (object 1) or cut off from it by the occluder's shadow (no depth: rule 1).
