@@ -20,8 +20,8 @@
 //   the object it stands against (a concave crease).
 // - Beyond the paper: a table face (TableHint) takes no pixel standing clear of the table's plane.
 // - Beyond the paper: in rules 2-3 a segment seen behind its one face across depth jumps (most of its
-//   contacts with it, Params::Remaining::occluded_jump) is an object that face hides, not a part of it;
-//   behind the face's own edge band, left as a segment of its own, counts as behind the face.
+//   contacts with it, Params::Remaining::occluded_jump) and nowhere within the jump of it in space is an
+//   object that face hides, not a part of it. In rule 5 a face it is seen behind takes none of it.
 // - Beyond the paper: in rules 1-3 a segment that would be an object of its own (hidden behind its one face,
 //   or cut off from every face by missing depth) joins the object on whose nearby faces' planes it lies, with
 //   only nearer things between (the co-planarity cue f/g for a segment; Params::Remaining::hidden_coplanar_band).
@@ -46,11 +46,9 @@ namespace clutterseg {
 
 namespace {
 
-// A segment is hidden behind its one face (Params::Remaining::occluded_jump) when its contacts across a jump
-// outnumber the continuous ones this many times and make at least this share of its ring: a few jump
-// contacts of a cylinder's top with its side (mixed-000004: 7 of 127 ring pixels) keep the top with the side.
+// A segment is seen behind a face (Params::Remaining::occluded_jump) when its contacts with the face across a
+// jump outnumber the continuous ones this many times.
 constexpr int kHiddenRatio = 4;
-constexpr double kHiddenRingShare = 0.06;
 // A hidden segment joins a face of another object when this share of its points lies on that face's plane;
 // at most this many faces near it are fitted.
 constexpr double kCoplanarShare = 0.8;
@@ -120,6 +118,38 @@ bool fit_local_plane(const cv::Mat& labels, const cv::Mat& points, int patch, cv
   if (!fit.plane(plane)) return false;
   centroid = fit.mean();
   return true;
+}
+
+// Whether some point of `segment` lies within `distance` (3D) of a point of `patch` in the segment's box
+// grown by its size: a surface that meets the face in space (a cylinder's top its side), not only in the
+// image (an object behind an occluder). Both sides are sampled (at most kMaxVisits face points).
+bool meets_in_space(std::span<const int> segment, const cv::Rect& bbox, const cv::Mat& labels, const cv::Mat& points,
+                    int patch, float distance) {
+  const cv::Rect image(0, 0, labels.cols, labels.rows);
+  const int margin = std::max(bbox.width, bbox.height);
+  const cv::Rect window = cv::Rect(bbox.x - margin, bbox.y - margin, bbox.width + 2 * margin, bbox.height + 2 * margin) & image;
+  const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
+  std::vector<Eigen::Vector3f> face;
+  for (int y = window.y; y < window.y + window.height; y += stride) {
+    const int* lab = labels.ptr<int>(y);
+    const auto* pts = points.ptr<cv::Vec3f>(y);
+    for (int x = window.x; x < window.x + window.width; x += stride)
+      if (lab[x] == patch && valid_point(pts[x])) face.emplace_back(pts[x][0], pts[x][1], pts[x][2]);
+  }
+  // By depth: a segment point looks only at the face points in its slab of depths (none, when hidden).
+  std::sort(face.begin(), face.end(), [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) { return a.z() < b.z(); });
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const size_t step = std::max<size_t>(1, segment.size() / 200);
+  const float d2 = distance * distance;
+  for (size_t k = 0; k < segment.size(); k += step) {
+    const cv::Vec3f& q = pts[segment[k]];
+    const Eigen::Vector3f p(q[0], q[1], q[2]);
+    auto f = std::lower_bound(face.begin(), face.end(), p.z() - distance,
+                              [](const Eigen::Vector3f& a, float z) { return a.z() < z; });
+    for (; f != face.end() && f->z() <= p.z() + distance; ++f)
+      if ((*f - p).squaredNorm() < d2) return true;
+  }
+  return false;
 }
 
 // Plane of `patch` near `bbox`: the window grows until the fit is possible (bounded: whole image).
@@ -218,7 +248,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   // them lie across a depth jump with the segment behind, or not.
   struct Face {
     int label, ring = 0, behind = 0, touching = 0;
-    bool hides() const { return behind > kHiddenRatio * touching; }  // one of several faces; see the rule below
+    bool hides() const { return behind > kHiddenRatio * touching; }  // contacts mostly across a jump
   };
   std::vector<Face> faces;  // per segment, sorted by label
   struct FacePlane {
@@ -299,7 +329,6 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     // segment is looked at, then unmarked: the work stays proportional to the segment).
     bool touches_border = false;
     int other_segment = 0, invalid = 0;
-    int behind_segment = 0;  // ring pixels of other segments across a depth jump, the segment behind
     faces.clear();
     ring.clear();
     for (int i : seg_pixels) state[static_cast<size_t>(i)] = kInSegment;
@@ -328,10 +357,6 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
           }
         } else if (state[static_cast<size_t>(j)] == (kGrown | kInRing)) {
           ++other_segment;
-          if (occluded_jump2 > 0 && valid_point(pts[j])) {  // e.g. the occluder's edge band that no patch took
-            const cv::Vec3f d = pts[i] - pts[j];
-            behind_segment += d.dot(d) > occluded_jump2 && pts[i][2] > pts[j][2];
-          }
         } else {
           ++invalid;
         }
@@ -348,6 +373,10 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         std::erase_if(faces, [&](const Face& f) { return is_table(f.label); });
     }
     auto set_all = [&](int object_id) { for (int i : seg_pixels) obj[i] = object_id; };
+    // Seen behind the face (most contacts across a jump) and meeting it nowhere in space: hidden by it.
+    const auto hidden_by = [&](const Face& f) {
+      return f.hides() && !meets_in_space(seg_pixels, seg.bbox, assigned_labels, points, f.label, static_cast<float>(params.occluded_jump));
+    };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
 
     if (faces.empty()) {                                              // rule 1
@@ -363,12 +392,9 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const bool tiny = static_cast<int>(seg_pixels.size()) < tiny_px;          // rule 2
       const Face& face = faces[0];
       const bool enclosed = !touches_border && other_segment == 0 && face.ring >= invalid;  // rule 3
-      // Beyond the paper: seen behind its one face across depth jumps (most of its contacts), the segment is
-      // an object that face hides, not a part of it. Behind the face's edge band (a segment of its own) counts
-      // as behind the face, once the face itself is seen in front somewhere.
-      const int seen_behind = face.behind > 0 ? face.behind + behind_segment : 0;
-      const bool hidden = seen_behind > kHiddenRatio * face.touching &&
-                          seen_behind >= kHiddenRingShare * static_cast<double>(ring.size());
+      // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
+      // near it in space, the segment is an object that face hides, not a part of it.
+      const bool hidden = !tiny && hidden_by(face);
       // Beyond the paper: hidden, it may be the far part of an object the face cuts in two (co-planarity, f/g).
       const int coplanar = !tiny && hidden && params.hidden_coplanar_band > 0
           ? coplanar_object(seg_pixels, seg.bbox, object_of(face.label)) : 0;

@@ -84,13 +84,15 @@ TEST(Remaining, Rule3EnclosedBecomesObjectElseJoins) {
 
 // Beyond the paper (Params::Remaining::occluded_jump): a segment seen behind its one face across a depth
 // jump is an object that face hides (a box nearly hidden behind a taller one), not a part of the face; in
-// front of it, or behind by less than the jump, it joins the face as in rule 3.
+// front of it, or behind by less than the jump, it joins the face as in rule 3. So does a segment that meets
+// the face in space away from their contacts in the image, as a cylinder's top meets its side at the rim.
 TEST(Remaining, ASegmentHiddenBehindItsOneFaceIsAnObjectOfItsOwn) {
-  const auto run = [](float z, double jump) {
+  const auto run = [](float z, double jump, bool face_reaches_back = false) {
     Case c;
     c.labels.setTo(1);
     c.labels(cv::Rect(0, 10, 8, 8)).setTo(0);  // 64 px at the image border: not enclosed
     c.depth(cv::Rect(0, 10, 8, 8)).setTo(z);
+    if (face_reaches_back) c.depth(cv::Rect(12, 10, 4, 8)).setTo(z);  // 1 cm from the segment in space
     Params::Remaining params;
     params.occluded_jump = jump;
     return assign_remaining(c.labels, {0}, 1, c.points(), NormalPlanes{}, params, 20).at<int>(14, 3);
@@ -99,12 +101,13 @@ TEST(Remaining, ASegmentHiddenBehindItsOneFaceIsAnObjectOfItsOwn) {
   EXPECT_EQ(run(1.10f, 0), 1);     // off: rule 3, not enclosed, joins
   EXPECT_EQ(run(1.02f, 0.03), 1);  // 2 cm behind: within the jump
   EXPECT_EQ(run(0.90f, 0.03), 1);  // in front of the face
+  EXPECT_EQ(run(1.10f, 0.03, true), 1);  // behind where they touch, but meeting the face in space
 }
 
 // The same on real frames (occluded-000018, a lying cylinder cut by an upright one): the occluder's edge band
 // is a segment of its own between the face and the far part, which touches the face itself in two pixels
-// only. Seen behind the band, the far part is still hidden by the face, not a part of it.
-TEST(Remaining, ASegmentHiddenBehindItsFacesEdgeBandIsAnObjectOfItsOwn) {
+// only. Those two contacts, both across the jump, are enough: the far part is hidden by the face.
+TEST(Remaining, ASegmentTouchingItsFaceInTwoPixelsAcrossAJumpIsHidden) {
   const auto run = [](float z, double jump) {
     Case c;
     c.labels.colRange(0, 15).setTo(1);                  // the occluder's face

@@ -145,9 +145,10 @@ struct Params {
                                  // is the shadow on the farther object, and that object's (holes.hpp) [m];
                                  // 0 = off (needs hole_px > 0)
     double occluded_jump = 0.03; // beyond the paper: a segment whose only neighbouring face (rules 2-3) touches
-                                 // it mostly across depth jumps larger than this, the segment behind, is an
-                                 // object that face hides, not a part of it; among several faces (rule 5)
-                                 // such a face takes none of it [m]; 0 = off (remaining.hpp)
+                                 // it mostly across depth jumps larger than this, the segment behind, and
+                                 // comes nowhere this near it in space, is an object that face hides, not a
+                                 // part of it; among several faces (rule 5) such a face takes none of it
+                                 // [m]; 0 = off (remaining.hpp)
     double hidden_coplanar_band = 0.008;  // beyond the paper (the co-planarity cue f/g for a remaining segment):
                                  // a segment hidden behind its face whose points lie within this of the
                                  // plane of a flat face of another object near it joins that object, the
