@@ -55,7 +55,7 @@ float length_along(const std::vector<int>& pixels, const cv::Mat& points, const 
 constexpr int kSamplesPerObject = 500;
 
 struct Heights {
-  int samples = 0, above_max = 0, below = 0, over_region = 0;
+  int samples = 0, above_max = 0, below = 0, over_region = 0, near_table = 0;
 };
 
 // Calls visit(object, begin, end) for every run of equal labels 1..num_objects in scan order: pixels
@@ -256,20 +256,6 @@ float share_hiding_something(const std::vector<int>& face, int id, const cv::Mat
   return seen > 0 ? static_cast<float>(hiding) / static_cast<float>(seen) : 0.f;
 }
 
-// Share of (a sample of) the pixels less than `height` above the plane, those below it included.
-float share_lower_than(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double height) {
-  const auto* pts = points.ptr<cv::Vec3f>();
-  const size_t stride = std::max<size_t>(1, pixels.size() / sample_budget(2000, points));
-  int low = 0, n = 0;
-  for (size_t k = 0; k < pixels.size(); k += stride) {
-    const cv::Vec3f& q = pts[pixels[k]];
-    if (!valid_point(q)) continue;
-    ++n;
-    low += plane.distance(Eigen::Vector3f(q[0], q[1], q[2])) < height;
-  }
-  return n > 0 ? static_cast<float>(low) / static_cast<float>(n) : 0.f;
-}
-
 }  // namespace
 
 std::vector<Object> describe_objects(const cv::Mat& object_labels, const cv::Mat& points,
@@ -315,6 +301,7 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
     h.above_max += d > params.max_height;
     h.below += d < -plane_tolerance(params.plane_band, q.z());
     h.over_region += support.region.over(q);
+    h.near_table += d < params.contact_distance;
   };
   for_each_run(object_labels, num_objects, [&](int o, int begin, int end) {
     if (objects[static_cast<size_t>(o)].support) return;
@@ -333,13 +320,12 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
     }
   });
   const Eigen::Vector3f up = support.plane.normal;
-  // Beyond the paper: an upright face standing on the table (its foot within contact distance) in front
+  // Beyond the paper: an upright object standing on the table (its foot within contact distance) in front
   // of something farther is an object, not a wall (a laptop's lid, a board); a wall above a ledge that
   // hides the room behind does not stand on the table.
   constexpr double kFootShare = 0.02;
-  const auto stands_in_front = [&](const std::vector<int>& face, int id) {
-    return params.wall_hides_share > 0 &&
-           share_lower_than(face, points, support.plane, params.contact_distance) >= kFootShare &&
+  const auto stands_in_front = [&](const std::vector<int>& face, int id, const Heights& h) {
+    return params.wall_hides_share > 0 && h.near_table >= kFootShare * h.samples &&
            share_hiding_something(face, id, object_labels, points, reach_px) >= params.wall_hides_share;
   };
   for (size_t o = 0; o < objects.size(); ++o) {
@@ -361,7 +347,7 @@ void classify_objects(std::vector<Object>& objects, const std::vector<Patch>& pa
     if (fit_plane(face, points, own) && mostly_within(face, points, own, params.plane_band, 0.9) &&
         std::abs(own.normal.dot(up)) < std::cos(60.0 * M_PI / 180.0) &&
         length_along(face, points, up.cross(own.normal).normalized()) >= params.wall_min_extent &&
-        !stands_in_front(face, object.id))
+        !stands_in_front(face, object.id, h))
       object.background = true;
   }
 }

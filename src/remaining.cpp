@@ -378,6 +378,12 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       return f.hides() && !meets_in_space(seg_pixels, seg.bbox, assigned_labels, points, f.label, static_cast<float>(params.occluded_jump));
     };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
+    // A hidden segment (not tiny): the far part of an object the face cuts in two (co-planarity, f/g), or an
+    // object of its own.
+    const auto hidden_object = [&](const Face& occluder) {
+      const int coplanar = params.hidden_coplanar_band > 0 ? coplanar_object(seg_pixels, seg.bbox, object_of(occluder.label)) : 0;
+      return coplanar > 0 ? coplanar : ++next_object;
+    };
 
     if (faces.empty()) {                                              // rule 1
       // A tiny segment alone is sensor noise (stereo sensors leave thousands of them), not an object.
@@ -394,11 +400,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const bool enclosed = !touches_border && other_segment == 0 && face.ring >= invalid;  // rule 3
       // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
       // near it in space, the segment is an object that face hides, not a part of it.
-      const bool hidden = !tiny && hidden_by(face);
-      // Beyond the paper: hidden, it may be the far part of an object the face cuts in two (co-planarity, f/g).
-      const int coplanar = !tiny && hidden && params.hidden_coplanar_band > 0
-          ? coplanar_object(seg_pixels, seg.bbox, object_of(face.label)) : 0;
-      set_all(coplanar > 0 ? coplanar : !tiny && (enclosed || hidden) ? ++next_object : object_of(face.label));
+      if (!tiny && hidden_by(face)) set_all(hidden_object(face));
+      else set_all(!tiny && enclosed ? ++next_object : object_of(face.label));
       continue;
     }
     // Beyond the paper: a face the segment is seen behind (most of their contacts across a jump) hides it and
@@ -406,10 +409,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     const Face longest = *std::max_element(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.ring < b.ring; });
     std::erase_if(faces, [](const Face& f) { return f.hides(); });
     if (faces.empty()) {
-      const bool tiny = static_cast<int>(seg_pixels.size()) < tiny_px;
-      const int coplanar = !tiny && params.hidden_coplanar_band > 0
-          ? coplanar_object(seg_pixels, seg.bbox, object_of(longest.label)) : 0;
-      set_all(coplanar > 0 ? coplanar : !tiny ? ++next_object : object_of(longest.label));
+      set_all(static_cast<int>(seg_pixels.size()) < tiny_px ? object_of(longest.label) : hidden_object(longest));
       continue;
     }
     const int first_object = object_of(faces[0].label);

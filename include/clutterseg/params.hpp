@@ -174,7 +174,7 @@ struct Params {
                                   // unmark_curved_table, beyond the paper); 0 = off
     double wall_min_extent = 0.35; // a flat object roughly perpendicular to the table (> 60 deg) whose
                                    // largest face is at least this long along the table is a wall [m]
-    double wall_hides_share = 0.25; // beyond the paper: ... unless it stands on the table (2 % of its face
+    double wall_hides_share = 0.25; // beyond the paper: ... unless it stands on the table (2 % of its pixels
                                     // within contact_distance) and at least this share of its outline hides
                                     // a surface 10 % farther: a laptop's lid (walls are the farthest
                                     // surface) [-]; 0 = off
