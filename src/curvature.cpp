@@ -135,12 +135,17 @@ Line fit_line(const std::vector<Eigen::Vector3f>& a, const std::vector<Eigen::Ve
   for (const auto* set : {&a, &b})
     for (const auto& p : *set) mean += p.cast<double>();
   mean /= static_cast<double>(a.size() + b.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  // The six sums of the scatter matrix as scalars: Eigen's `cov += d * d.transpose()` went through the
+  // stack for every point, a stalled store-to-load that was most of this stage's time (same sums).
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
   for (const auto* set : {&a, &b})
     for (const auto& p : *set) {
       const Eigen::Vector3d d = p.cast<double>() - mean;
-      cov += d * d.transpose();
+      xx += d.x() * d.x(); xy += d.x() * d.y(); xz += d.x() * d.z();
+      yy += d.y() * d.y(); yz += d.y() * d.z(); zz += d.z() * d.z();
     }
+  Eigen::Matrix3d cov;
+  cov << xx, xy, xz, xy, yy, yz, xz, yz, zz;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
   return {mean.cast<float>(), eig.eigenvectors().col(2).normalized().cast<float>()};
 }
@@ -257,20 +262,31 @@ int convexity(const Patch& patch, const cv::Mat& points, const NormalPlanes& nor
   const auto* pts = points.ptr<cv::Vec3f>();
   const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
   const size_t stride = std::max<size_t>(1, patch.pixels.size() / sample_budget(kConvexitySamples, points));
-  Eigen::Vector3d sn = Eigen::Vector3d::Zero(), sp = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d snn = Eigen::Matrix3d::Zero(), snp = Eigen::Matrix3d::Zero(), spp = Eigen::Matrix3d::Zero();
+  // Sums as plain scalars (Eigen's outer-product updates went through the stack for every pixel).
+  double n0 = 0, n1 = 0, n2 = 0, p0 = 0, p1 = 0, p2 = 0;
+  double nn[6] = {}, pp[6] = {}, np[9] = {};  // nn, pp: upper triangles, row by row; np: row-major
   double count = 0;
   for (size_t k = 0; k < patch.pixels.size(); k += stride) {
     const int i = patch.pixels[k];
     if (!(pts[i][2] > 0) || (nx[i] == 0 && ny[i] == 0 && nz[i] == 0)) continue;
-    const Eigen::Vector3d n(nx[i], ny[i], nz[i]), p = vec(pts[i]).cast<double>();
-    sn += n; sp += p;
-    snn.noalias() += n * n.transpose();
-    snp.noalias() += n * p.transpose();
-    spp.noalias() += p * p.transpose();
+    const double a0 = nx[i], a1 = ny[i], a2 = nz[i];
+    const double b0 = pts[i][0], b1 = pts[i][1], b2 = pts[i][2];
+    n0 += a0; n1 += a1; n2 += a2; p0 += b0; p1 += b1; p2 += b2;
+    nn[0] += a0 * a0; nn[1] += a0 * a1; nn[2] += a0 * a2; nn[3] += a1 * a1; nn[4] += a1 * a2; nn[5] += a2 * a2;
+    pp[0] += b0 * b0; pp[1] += b0 * b1; pp[2] += b0 * b2; pp[3] += b1 * b1; pp[4] += b1 * b2; pp[5] += b2 * b2;
+    np[0] += a0 * b0; np[1] += a0 * b1; np[2] += a0 * b2; np[3] += a1 * b0; np[4] += a1 * b1; np[5] += a1 * b2;
+    np[6] += a2 * b0; np[7] += a2 * b1; np[8] += a2 * b2;
     ++count;
   }
   if (count < 10) return 0;
+  const auto symmetric = [](const double* u) {
+    Eigen::Matrix3d m;
+    m << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
+    return m;
+  };
+  const Eigen::Vector3d sn(n0, n1, n2), sp(p0, p1, p2);
+  const Eigen::Matrix3d snn = symmetric(nn), spp = symmetric(pp);
+  const Eigen::Matrix3d snp = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(np);
   const Eigen::Vector3d n_mean = sn / count, p_mean = sp / count;
   const Eigen::Matrix3d n_cov = snn / count - n_mean * n_mean.transpose();
   const Eigen::Matrix3d np_cov = snp / count - n_mean * p_mean.transpose();
