@@ -164,11 +164,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
       const int sx = static_cast<int>(yx & 0xffff), sy = static_cast<int>(yx >> 16);
       const int dx = sx - x, dy = sy - y;
       own.offer(yx, label, [&] { return dx * dx + dy * dy <= r2; }, [&] {
-        if (!has_point) return static_cast<float>(dx * dx + dy * dy);
-        // cv::Vec3f's difference and dot, written out: the same operations in the same order.
-        const cv::Vec3f& q = pts[sy * width + sx];
-        const float ex = q[0] - here[0], ey = q[1] - here[1], ez = q[2] - here[2];
-        return ex * ex + ey * ey + ez * ez;
+        return has_point ? distance2(pts[sy * width + sx], here) : static_cast<float>(dx * dx + dy * dy);
       }, has_point ? d2_max : std::numeric_limits<float>::infinity());
     };
     auto visit = [&](int j, int xx, int yy) {

@@ -230,8 +230,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
           }
           const uchar here = state[static_cast<size_t>(j)];
           if (here == kRemaining) {
-            const cv::Vec3f d = pts[i] - pts[j];
-            if (d.dot(d) < limit2[static_cast<size_t>(s)]) {
+            if (distance2(pts[i], pts[j]) < limit2[static_cast<size_t>(s)]) {
               state[static_cast<size_t>(j)] = kGrown;
               pixels.push_back(j);
             }
@@ -352,8 +351,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
           if (face == faces.end()) face = faces.insert(faces.end(), Face{lab[j]});
           ++face->ring;
           if (occluded_jump2 > 0 && !is_table(lab[j])) {
-            const cv::Vec3f d = pts[i] - pts[j];
-            if (d.dot(d) > occluded_jump2 && pts[i][2] > pts[j][2]) ++face->behind; else ++face->touching;
+            if (distance2(pts[i], pts[j]) > occluded_jump2 && pts[i][2] > pts[j][2]) ++face->behind; else ++face->touching;
           }
         } else if (state[static_cast<size_t>(j)] == (kGrown | kInRing)) {
           ++other_segment;
