@@ -56,7 +56,9 @@ float patch_radius(const Patch& patch, const cv::Mat& points) {
 }
 
 // Cheap necessary conditions, in order of cost: flat, parallel, in each other's plane, close enough.
-bool plausible(const Patch& a, float radius_a, const Patch& b, float radius_b, const Params::Coplanarity& p) {
+// The radii are asked for last (`radius(patch)`): reading a patch's pixels is the costly part.
+template <typename Radius>
+bool plausible(const Patch& a, const Patch& b, const Params::Coplanarity& p, Radius radius) {
   if (a.curved || b.curved || a.pixels.empty() || b.pixels.empty()) return false;
   const float cos_max = static_cast<float>(std::cos(p.angle_deg * M_PI / 180.0));
   if (a.mean_normal.dot(b.mean_normal) < cos_max) return false;
@@ -66,7 +68,7 @@ bool plausible(const Patch& a, float radius_a, const Patch& b, float radius_b, c
   const float len = d.norm();
   const float sin_max = static_cast<float>(std::sin(p.angle_deg * M_PI / 180.0));
   if (std::abs(a.mean_normal.dot(d)) > sin_max * len || std::abs(b.mean_normal.dot(d)) > sin_max * len) return false;
-  return len - radius_a - radius_b <= p.max_gap;
+  return len - radius(a) - radius(b) <= p.max_gap;
 }
 
 // Paper g): point triples spanning both patches span the patches' plane, and the gap between them is
@@ -108,7 +110,7 @@ bool spans_plane_and_occluded(const Patch& a, const Patch& b, const cv::Mat& poi
 bool coplanar(const Patch& a, const Patch& b, const cv::Mat& points, const Camera& camera,
               const Params::Coplanarity& params, std::uint64_t seed) {
   if (a.curved || b.curved || a.pixels.empty() || b.pixels.empty()) return false;
-  return plausible(a, patch_radius(a, points), b, patch_radius(b, points), params) &&
+  return plausible(a, b, params, [&](const Patch& patch) { return patch_radius(patch, points); }) &&
          spans_plane_and_occluded(a, b, points, camera, params, seed);
 }
 
@@ -124,12 +126,16 @@ std::vector<PatchPair> coplanar_pairs(const std::vector<Patch>& patches, const s
   std::sort(known.begin(), known.end());
 
   std::vector<int> flat;
-  std::vector<float> radius(patches.size(), 0.f);
   for (size_t i = 0; i < patches.size(); ++i)
-    if (!patches[i].curved && !patches[i].pixels.empty()) {
-      flat.push_back(static_cast<int>(i));
-      radius[i] = patch_radius(patches[i], points);
-    }
+    if (!patches[i].curved && !patches[i].pixels.empty()) flat.push_back(static_cast<int>(i));
+  // A patch's radius once, and only for the patches of a pair that passes the other tests (most pairs do
+  // not; the table's radius alone reads a third of the frame).
+  std::vector<float> radius(patches.size(), -1.f);
+  const auto radius_of = [&](const Patch& patch) {
+    float& r = radius[static_cast<size_t>(&patch - patches.data())];
+    if (r < 0) r = patch_radius(patch, points);
+    return r;
+  };
 
   // Cheap rejections on all pairs first; the sampled test only on the few survivors.
   std::vector<PatchPair> candidates;
@@ -137,8 +143,7 @@ std::vector<PatchPair> coplanar_pairs(const std::vector<Patch>& patches, const s
     for (size_t y = x + 1; y < flat.size(); ++y) {
       const int i = flat[x], j = flat[y];
       if (std::binary_search(known.begin(), known.end(), PatchPair(i, j))) continue;
-      if (plausible(patches[static_cast<size_t>(i)], radius[static_cast<size_t>(i)],
-                    patches[static_cast<size_t>(j)], radius[static_cast<size_t>(j)], params))
+      if (plausible(patches[static_cast<size_t>(i)], patches[static_cast<size_t>(j)], params, radius_of))
         candidates.emplace_back(i, j);
     }
 
