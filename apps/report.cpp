@@ -50,11 +50,12 @@ std::string cell(const GroupSummary& g, size_t metric) {
 // Headers of the error breakdown (kBreakdownNames), then the three event counts.
 constexpr std::array<const char*, kBreakdownNames.size()> kBreakdownTitles = {
     "R: kept", "R: boundary", "R: dropped", "R: split off", "R: merged away", "R: lost, no depth",
-    "P: correct", "P: boundary", "P: table/bg", "P: other object", "P: extra segments"};
+    "tp limit (depth)", "P: correct", "P: boundary", "P: table/bg", "P: other object", "P: extra segments"};
 constexpr std::array<const char*, 3> kEventTitles = {"merged objects", "split objects", "missed objects"};
 constexpr const char* kBreakdownLegend =
     "R: shares of the ground-truth object pixels (kept = Overlap R); lost, no depth = the lost ones without a "
-    "depth measurement, already counted in the columns before it; P: shares of the predicted object pixels "
+    "depth measurement, already counted in the columns before it; tp limit = the paper's tp of a method that "
+    "labels exactly every object pixel with depth and no other (mean measured share of the objects); P: shares of the predicted object pixels "
     "(correct = Overlap P); boundary = wrong but within the boundary tolerance of a ground-truth boundary; "
     "objects: counts over the frames (docs/EVAL.md)";
 

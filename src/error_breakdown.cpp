@@ -20,8 +20,9 @@ cv::Mat int_labels(const cv::Mat& image, const char* what) {
 
 }  // namespace
 
-std::array<double, 11> breakdown_values(const ErrorBreakdown& b) {
-  return {b.kept, b.boundary, b.dropped, b.split, b.merged, b.no_depth, b.correct, b.boundary_p, b.background, b.merged_p, b.extra};
+std::array<double, 12> breakdown_values(const ErrorBreakdown& b) {
+  return {b.kept, b.boundary, b.dropped, b.split, b.merged, b.no_depth, b.tp_limit,
+          b.correct, b.boundary_p, b.background, b.merged_p, b.extra};
 }
 
 ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& prediction,
@@ -47,7 +48,7 @@ ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& predi
   enum { kKept, kBoundary, kDropped, kSplit, kMerged, kCorrect, kBoundaryP, kBackground, kMergedP, kExtra, kNoDepth, kCount };
   std::array<long, kCount> count{};
   std::map<std::pair<int, int>, long> overlap;  // (gt id, pred id) -> pixels: bounded by the pixels
-  std::map<int, long> gt_area;
+  std::map<int, long> gt_area, gt_measured;
   const auto matched = [](const std::unordered_map<int, int>& m, int id) {
     const auto it = m.find(id);
     return it == m.end() ? 0 : it->second;
@@ -60,6 +61,7 @@ ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& predi
     for (int x = 0; x < gt.cols; ++x) {
       if (g[x] != 0) {  // where a ground-truth pixel went
         ++gt_area[g[x]];
+        if (no_measurement && !no_measurement[x]) ++gt_measured[g[x]];
         if (p[x] != 0) ++overlap[{g[x], p[x]}];
         const int own = matched(pred_of_gt, g[x]);
         const bool kept = own != 0 && p[x] == own;
@@ -89,7 +91,12 @@ ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& predi
     b.dropped = count[kDropped] / gt_pixels;
     b.split = count[kSplit] / gt_pixels;
     b.merged = count[kMerged] / gt_pixels;
-    if (!unmeasured.empty()) b.no_depth = count[kNoDepth] / gt_pixels;
+    if (!unmeasured.empty()) {
+      b.no_depth = count[kNoDepth] / gt_pixels;
+      double share_sum = 0;
+      for (const auto& [g, area] : gt_area) share_sum += static_cast<double>(gt_measured[g]) / static_cast<double>(area);
+      b.tp_limit = share_sum / static_cast<double>(gt_area.size());
+    }
     // An empty prediction has no precision to lose (score_frame gives it P = 0 by convention).
     b.correct = b.boundary_p = b.background = b.merged_p = b.extra = 0;
   }

@@ -115,3 +115,21 @@ TEST(ErrorBreakdown, LostPixelsWithoutDepthAreCountedBesideTheirCause) {
   EXPECT_TRUE(std::isnan(error_breakdown(gt, pred, score_frame(gt, pred).matches).no_depth));
   EXPECT_THROW(error_breakdown(gt, pred, score_frame(gt, pred).matches, depth(cv::Rect(0, 0, 50, 50))), Error);
 }
+
+TEST(ErrorBreakdown, TpLimitIsTheMeanMeasuredShareOfTheObjects) {
+  // Two objects: one fully measured, one with a quarter of it in a hole (the projector's shadow). A method
+  // that labels exactly the measured pixels scores the paper's tp (1 + 0.75) / 2, whatever it predicts.
+  cv::Mat gt = with(blank(), cv::Rect(10, 10, 20, 20), 1);  // 400 px
+  gt = with(gt, cv::Rect(50, 10, 20, 20), 2);                // 400 px
+  cv::Mat depth(gt.size(), CV_16U, cv::Scalar(1000));
+  depth(cv::Rect(50, 10, 5, 20)).setTo(0);  // 100 px of object 2
+  depth(cv::Rect(0, 40, 30, 5)).setTo(0);   // a hole on the table: no object's, no effect
+  cv::Mat measured_only = gt.clone();
+  measured_only.setTo(0, depth == 0);
+  for (const cv::Mat& pred : {gt, measured_only, blank()}) {
+    const ErrorBreakdown b = error_breakdown(gt, pred, score_frame(gt, pred).matches, depth);
+    EXPECT_DOUBLE_EQ(b.tp_limit, 0.875);
+  }
+  EXPECT_DOUBLE_EQ(score_frame(gt, measured_only).tp, 0.875);  // the limit is that method's tp
+  EXPECT_TRUE(std::isnan(error_breakdown(gt, gt, score_frame(gt, gt).matches).tp_limit));  // no depth given
+}

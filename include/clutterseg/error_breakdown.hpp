@@ -22,6 +22,9 @@ struct ErrorBreakdown {
   double no_depth = kNaN;   // of the above but kept: the pixels without a depth measurement (not a cause of
                             // its own, a share of all ground-truth object pixels as well): what no depth-only
                             // method can place, the limit of Overlap R; NaN when no depth image is given
+  double tp_limit = kNaN;   // the paper's tp of a method that labels exactly the pixels with depth of every
+                            // object: the mean over the objects of their measured share (the tp a depth-only
+                            // method reaches without guessing into holes); NaN when no depth image is given
   // Predicted object pixels (shares sum to 1): what each covers.
   double correct = kNaN;          // its segment's matched object (Overlap P)
   double boundary_p = kNaN;       // elsewhere, but within the boundary tolerance
@@ -34,14 +37,15 @@ struct ErrorBreakdown {
   int missed_objects = 0;   // objects with no matched segment
 };
 
-inline constexpr std::array<const char*, 11> kBreakdownNames = {
-    "kept", "boundary", "dropped", "split", "merged", "no_depth", "correct", "boundary_p", "background", "merged_p", "extra"};
-std::array<double, 11> breakdown_values(const ErrorBreakdown& b);
+inline constexpr std::array<const char*, 12> kBreakdownNames = {
+    "kept", "boundary", "dropped", "split", "merged", "no_depth", "tp_limit",
+    "correct", "boundary_p", "background", "merged_p", "extra"};
+std::array<double, 12> breakdown_values(const ErrorBreakdown& b);
 
 // The breakdown of one image, given the one-to-one matching of score_frame (FrameScores::matches):
 // pixels within boundary_tolerance_px of a ground-truth object boundary that are wrong count as
 // boundary errors whatever else they are. Images as for score_frame; `depth` (optional, CV_16U or CV_32F
-// of the same size, 0 or NaN = no measurement) gives ErrorBreakdown::no_depth.
+// of the same size, 0 or NaN = no measurement) gives ErrorBreakdown::no_depth and tp_limit.
 ErrorBreakdown error_breakdown(const cv::Mat& ground_truth, const cv::Mat& prediction,
                                const std::vector<std::pair<int, int>>& matches, const cv::Mat& depth = cv::Mat());
 
