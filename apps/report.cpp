@@ -55,9 +55,9 @@ constexpr std::array<const char*, 3> kEventTitles = {"merged objects", "split ob
 constexpr const char* kBreakdownLegend =
     "R: shares of the ground-truth object pixels (kept = Overlap R); lost, no depth = the lost ones without a "
     "depth measurement, already counted in the columns before it; tp limit = the paper's tp of a method that "
-    "labels exactly every object pixel with depth and no other (mean measured share of the objects); P: shares of the predicted object pixels "
-    "(correct = Overlap P); boundary = wrong but within the boundary tolerance of a ground-truth boundary; "
-    "objects: counts over the frames (docs/EVAL.md)";
+    "labels exactly every object pixel with depth and no other (mean measured share of the objects); P: shares "
+    "of the predicted object pixels (correct = Overlap P); boundary = wrong but within the boundary tolerance "
+    "of a ground-truth boundary; objects: counts over the frames (docs/EVAL.md)";
 
 std::array<int, 3> events(const GroupSummary& g) { return {g.merged_objects, g.split_objects, g.missed_objects}; }
 
