@@ -6,6 +6,7 @@
 
 #include "clutterseg/occlusion.hpp"
 #include "clutterseg/parallel.hpp"
+#include "clutterseg/support.hpp"
 
 namespace clutterseg {
 
@@ -55,11 +56,22 @@ float patch_radius(const Patch& patch, const cv::Mat& points) {
   return std::sqrt(r2);
 }
 
-// Cheap necessary conditions, in order of cost: flat, parallel, in each other's plane, close enough.
-// The radii are asked for last (`radius(patch)`): reading a patch's pixels is the costly part.
-template <typename Radius>
-bool plausible(const Patch& a, const Patch& b, const Params::Coplanarity& p, Radius radius) {
-  if (a.curved || b.curved || a.pixels.empty() || b.pixels.empty()) return false;
+// Whether a patch takes part: flat by its histogram (the paper), or beyond the paper planar by its points
+// although its histogram counts as curved (Params::Coplanarity::planar_share).
+bool takes_part(const Patch& patch, const cv::Mat& points, const Params::Coplanarity& p) {
+  if (patch.pixels.empty()) return false;
+  if (!patch.curved) return true;
+  Plane plane;
+  return p.planar_share > 0 && fit_plane(patch.pixels, points, plane) &&
+         mostly_within(patch.pixels, points, plane, p.planar_band, p.planar_share);
+}
+
+// Cheap necessary conditions, in order of cost: parallel, in each other's plane, both taking part
+// (`part(patch)`), close enough (`radius(patch)`). The last two read a patch's pixels: asked for only
+// when the angles pass.
+template <typename TakesPart, typename Radius>
+bool plausible(const Patch& a, const Patch& b, const Params::Coplanarity& p, TakesPart part, Radius radius) {
+  if (a.pixels.empty() || b.pixels.empty()) return false;
   const float cos_max = static_cast<float>(std::cos(p.angle_deg * M_PI / 180.0));
   if (a.mean_normal.dot(b.mean_normal) < cos_max) return false;
   // The line between the centroids must lie within angle_deg of both planes (the same bound the
@@ -68,13 +80,15 @@ bool plausible(const Patch& a, const Patch& b, const Params::Coplanarity& p, Rad
   const float len = d.norm();
   const float sin_max = static_cast<float>(std::sin(p.angle_deg * M_PI / 180.0));
   if (std::abs(a.mean_normal.dot(d)) > sin_max * len || std::abs(b.mean_normal.dot(d)) > sin_max * len) return false;
-  return len - radius(a) - radius(b) <= p.max_gap;
+  return part(a) && part(b) && len - radius(a) - radius(b) <= p.max_gap;
 }
 
 // Paper g): point triples spanning both patches span the patches' plane, and the gap between them is
-// occluded along random lines.
+// occluded along random lines: little behind them, and (for a pair with a histogram-curved patch, beyond
+// the paper) front_fraction in front.
 bool spans_plane_and_occluded(const Patch& a, const Patch& b, const cv::Mat& points, const Camera& camera,
                               const Params::Coplanarity& p, std::uint64_t seed) {
+  const double front_needed = a.curved || b.curved ? p.front_fraction : 0.0;
   std::mt19937_64 rng(pair_seed(seed, a.id, b.id));
   const Eigen::Vector3f mean = (a.mean_normal + b.mean_normal).normalized();
   const float cos_max = static_cast<float>(std::cos(p.angle_deg * M_PI / 180.0));
@@ -100,7 +114,8 @@ bool spans_plane_and_occluded(const Patch& a, const Patch& b, const cv::Mat& poi
   int passed = 0;
   for (int l = 0; l < p.lines; ++l) {
     const Eigen::Vector3f from = random_point(a, points, rng), to = random_point(b, points, rng);
-    if (behind_fraction(from, to, points, camera, p.behind_tolerance) <= p.behind_fraction) ++passed;
+    const GapView gap = view_gap(from, to, points, camera, p.behind_tolerance);
+    if (gap.behind <= p.behind_fraction && gap.in_front >= front_needed) ++passed;
   }
   return passed >= static_cast<int>(std::ceil(p.lines_pass * p.lines - 1e-9));
 }
@@ -109,8 +124,8 @@ bool spans_plane_and_occluded(const Patch& a, const Patch& b, const cv::Mat& poi
 
 bool coplanar(const Patch& a, const Patch& b, const cv::Mat& points, const Camera& camera,
               const Params::Coplanarity& params, std::uint64_t seed) {
-  if (a.curved || b.curved || a.pixels.empty() || b.pixels.empty()) return false;
-  return plausible(a, b, params, [&](const Patch& patch) { return patch_radius(patch, points); }) &&
+  return plausible(a, b, params, [&](const Patch& patch) { return takes_part(patch, points, params); },
+                   [&](const Patch& patch) { return patch_radius(patch, points); }) &&
          spans_plane_and_occluded(a, b, points, camera, params, seed);
 }
 
@@ -125,26 +140,30 @@ std::vector<PatchPair> coplanar_pairs(const std::vector<Patch>& patches, const s
     if (pair.first > pair.second) std::swap(pair.first, pair.second);
   std::sort(known.begin(), known.end());
 
-  std::vector<int> flat;
-  for (size_t i = 0; i < patches.size(); ++i)
-    if (!patches[i].curved && !patches[i].pixels.empty()) flat.push_back(static_cast<int>(i));
-  // A patch's radius once, and only for the patches of a pair that passes the other tests (most pairs do
-  // not; the table's radius alone reads a third of the frame).
+  // Per patch, once and only for the patches of a pair whose angles pass (most pairs do not): whether it
+  // takes part (a plane fit, for a patch whose histogram counts as curved) and its radius (the table's
+  // alone reads a third of the frame).
+  const auto index_of = [&](const Patch& patch) { return static_cast<size_t>(&patch - patches.data()); };
+  std::vector<signed char> part(patches.size(), -1);
+  const auto part_of = [&](const Patch& patch) {
+    signed char& t = part[index_of(patch)];
+    if (t < 0) t = takes_part(patch, points, params) ? 1 : 0;
+    return t == 1;
+  };
   std::vector<float> radius(patches.size(), -1.f);
   const auto radius_of = [&](const Patch& patch) {
-    float& r = radius[static_cast<size_t>(&patch - patches.data())];
+    float& r = radius[index_of(patch)];
     if (r < 0) r = patch_radius(patch, points);
     return r;
   };
 
   // Cheap rejections on all pairs first; the sampled test only on the few survivors.
   std::vector<PatchPair> candidates;
-  for (size_t x = 0; x < flat.size(); ++x)
-    for (size_t y = x + 1; y < flat.size(); ++y) {
-      const int i = flat[x], j = flat[y];
-      if (std::binary_search(known.begin(), known.end(), PatchPair(i, j))) continue;
-      if (plausible(patches[static_cast<size_t>(i)], patches[static_cast<size_t>(j)], params, radius_of))
-        candidates.emplace_back(i, j);
+  for (size_t i = 0; i < patches.size(); ++i)
+    for (size_t j = i + 1; j < patches.size(); ++j) {
+      if (std::binary_search(known.begin(), known.end(), PatchPair(static_cast<int>(i), static_cast<int>(j)))) continue;
+      if (plausible(patches[i], patches[j], params, part_of, radius_of))
+        candidates.emplace_back(static_cast<int>(i), static_cast<int>(j));
     }
 
   // Each pair draws from its own seeded stream, so the result does not depend on the thread count.

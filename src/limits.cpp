@@ -73,6 +73,9 @@ void validate(const Params& p) {
   in_range("coplanarity.behind_tolerance", p.coplanarity.behind_tolerance, 0, 1);
   in_range("coplanarity.lines_pass", p.coplanarity.lines_pass, 0, 1);
   in_range("coplanarity.max_gap", p.coplanarity.max_gap, 0, 10);
+  in_range("coplanarity.planar_share", p.coplanarity.planar_share, 0, 1);
+  in_range("coplanarity.planar_band", p.coplanarity.planar_band, 0, 1);
+  in_range("coplanarity.front_fraction", p.coplanarity.front_fraction, 0, 1);
   in_range("curvature.theta_h", p.curvature.theta_h, 0, 1);
   in_range("curvature.line_fit", p.curvature.line_fit, 0, 1);
   in_range("curvature.neighbour_gap_px", p.curvature.neighbour_gap_px, 0, 50);

@@ -5,9 +5,9 @@
 
 namespace clutterseg {
 
-double behind_fraction(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const cv::Mat& points,
-                       const Camera& camera, double tolerance) {
-  if (points.empty() || a.z() <= 0 || b.z() <= 0) return 0;
+GapView view_gap(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const cv::Mat& points, const Camera& camera,
+                 double tolerance) {
+  if (points.empty() || a.z() <= 0 || b.z() <= 0) return {};
   if (points.type() != CV_32FC3) throw Error("behind_fraction: points must be a CV_32FC3 image");
   const double fx = camera.fx, fy = camera.fy, cx = camera.cx, cy = camera.cy;
   const double ua = fx * a.x() / a.z() + cx, va = fy * a.y() / a.z() + cy;
@@ -20,7 +20,7 @@ double behind_fraction(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const
   const int steps = std::clamp(static_cast<int>(std::ceil(span - 1e-6)), 1, max_steps);
   const double inv_za = 1.0 / a.z(), inv_zb = 1.0 / b.z();
 
-  int valid = 0, behind = 0;
+  int valid = 0, behind = 0, in_front = 0;
   for (int k = 0; k <= steps; ++k) {
     const double t = static_cast<double>(k) / steps;
     const int u = static_cast<int>(std::lround(ua + t * du));
@@ -35,9 +35,17 @@ double behind_fraction(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const
     // Compare ranges along the pixel's ray, so the tolerance is a distance in metres.
     const double ray = std::sqrt(1.0 + std::pow((u - cx) / fx, 2) + std::pow((v - cy) / fy, 2));
     ++valid;
-    if ((measured[2] - z_segment) * ray > tolerance) ++behind;
+    const double offset = (measured[2] - z_segment) * ray;
+    behind += offset > tolerance;
+    in_front += offset < -tolerance;
   }
-  return valid ? static_cast<double>(behind) / valid : 0.0;
+  if (!valid) return {};
+  return {static_cast<double>(behind) / valid, static_cast<double>(in_front) / valid};
+}
+
+double behind_fraction(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const cv::Mat& points,
+                       const Camera& camera, double tolerance) {
+  return view_gap(a, b, points, camera, tolerance).behind;
 }
 
 }  // namespace clutterseg

@@ -101,13 +101,54 @@ TEST(Coplanarity, SkipsLinkedPairsAndObeysTheSwitch) {
   EXPECT_TRUE(coplanar_pairs(b.s.result.patches, {}, b.s.result.points, camera, off, 1).empty());
 }
 
-TEST(Coplanarity, CurvedPatchesAreNeverCoplanar) {
+TEST(Coplanarity, CurvedPatchesAreNeverCoplanar) {  // curved by histogram and by their points
   const TestScene scene = lying_cylinder_occluded();
   const Segmented s = segment_scene(scene);
   const auto parts = patches_on(s, 1);
   ASSERT_EQ(parts.size(), 2u);
   ASSERT_TRUE(patch(s, parts[0]).curved);
   EXPECT_FALSE(coplanar(patch(s, parts[0]), patch(s, parts[1]), s.result.points, scene.camera, {}, 1));
+}
+
+// Beyond the paper: a flat face whose normal histogram counts as curved (sensor noise on a thin or far
+// face) takes part when its points are planar, and then needs an occluder in front of the gap.
+namespace {
+Patch with_noisy_histogram(Patch patch) {
+  patch.curved = true;
+  return patch;
+}
+}  // namespace
+
+TEST(Coplanarity, APlanarFaceWithANoisyHistogramJoinsAcrossAnOccluder) {
+  const SplitBox b = split_box();
+  const Camera camera = occluded_box_split().camera;
+  const Patch a = with_noisy_histogram(patch(b.s, b.front[0])), c = with_noisy_histogram(patch(b.s, b.front[1]));
+  EXPECT_TRUE(coplanar(a, c, b.s.result.points, camera, {}, 1));  // the occluder stands in front of the gap
+  Params::Coplanarity paper;  // flat patches only
+  paper.planar_share = 0;
+  EXPECT_FALSE(coplanar(a, c, b.s.result.points, camera, paper, 1));
+  Params::Coplanarity far_in_front;  // more of every line in front than the occluder covers
+  far_in_front.front_fraction = 0.99;
+  EXPECT_FALSE(coplanar(a, c, b.s.result.points, camera, far_in_front, 1));
+}
+
+TEST(Coplanarity, TouchingCoplanarTopsWithNothingInFrontStayApart) {
+  // Two boxes' tops at one height. With the background test blinded (as when the gap between two touching
+  // boxes shows nothing behind), flat tops are joined; tops that count as curved need an occluder in front
+  // of the gap, and there is none.
+  const TestScene scene = separate_boxes();
+  const Segmented s = segment_scene(scene);
+  const auto top1 = facing(s, patches_on(s, 1), direction_up(scene));
+  const auto top2 = facing(s, patches_on(s, 2), direction_up(scene));
+  ASSERT_EQ(top1.size(), 1u);
+  ASSERT_EQ(top2.size(), 1u);
+  Params::Coplanarity blind;
+  blind.behind_fraction = 1.0;
+  const Patch a = with_noisy_histogram(patch(s, top1[0])), c = with_noisy_histogram(patch(s, top2[0]));
+  EXPECT_TRUE(coplanar(patch(s, top1[0]), patch(s, top2[0]), s.result.points, scene.camera, blind, 1));
+  EXPECT_FALSE(coplanar(a, c, s.result.points, scene.camera, blind, 1));
+  blind.front_fraction = 0;
+  EXPECT_TRUE(coplanar(a, c, s.result.points, scene.camera, blind, 1));
 }
 
 TEST(Coplanarity, AngleToleranceIsHonoured) {

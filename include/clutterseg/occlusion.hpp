@@ -12,6 +12,15 @@ namespace clutterseg {
 double behind_fraction(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const cv::Mat& points,
                        const Camera& camera, double tolerance);
 
+// What the segment from a to b crosses, sampled as behind_fraction does: the shares of the valid samples
+// that lie behind it and in front of it by more than `tolerance` (both 0 when no valid sample exists).
+struct GapView {
+  double behind = 0;
+  double in_front = 0;
+};
+GapView view_gap(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const cv::Mat& points, const Camera& camera,
+                 double tolerance);
+
 // The check as a stage outside co-planarity runs it: the camera and co-planarity's settings
 // (Params::Coplanarity::behind_tolerance and behind_fraction), so that both stages judge a gap alike.
 struct OcclusionCheck {
