@@ -13,7 +13,8 @@ namespace clutterseg {
 bool coplanar(const Patch& a, const Patch& b, const cv::Mat& points, const Camera& camera,
               const Params::Coplanarity& params, std::uint64_t seed);
 
-// All co-planar pairs among the patches that take part (as above) that are not already in `linked`.
+// All co-planar pairs among the patches that take part (as above; no table patch) that are not already in
+// `linked`.
 std::vector<PatchPair> coplanar_pairs(const std::vector<Patch>& patches,
                                       const std::vector<PatchPair>& linked, const cv::Mat& points,
                                       const Camera& camera, const Params::Coplanarity& params,

@@ -105,9 +105,10 @@ struct Params {
     double max_gap = 0.3;        // patches farther apart than this are never joined [m]
     // Beyond the paper: a patch whose normal histogram counts as curved (sensor noise spreads a thin or far
     // face's normals over many bins) takes part when planar_share of its points lie within planar_band
-    // (growing with z^2 beyond 1 m, as plane_tolerance) of its least-squares plane; 0 = only flat patches,
-    // as the paper. A pair with such a patch also needs an occluder: front_fraction of the samples of each
-    // passing line in front of it, so that the touching coplanar tops of two boxes are not joined.
+    // (growing with z^2 beyond 1 m, as plane_tolerance) of the plane through its centroid along its mean
+    // normal; 0 = only flat patches, as the paper. A pair with such a patch also needs an occluder:
+    // front_fraction of the samples of each passing line in front of it, so that the touching coplanar
+    // tops of two boxes are not joined.
     double planar_share = 0.9;   // [-], 0 = off
     double planar_band = 0.008;  // [m]
     double front_fraction = 0.1; // [-]
