@@ -59,7 +59,6 @@ float patch_radius(const Patch& patch, const cv::Mat& points) {
 // Whether a patch takes part: flat by its histogram (the paper), or beyond the paper planar by its points
 // although its histogram counts as curved (Params::Coplanarity::planar_share).
 bool takes_part(const Patch& patch, const cv::Mat& points, const Params::Coplanarity& p) {
-  if (patch.pixels.empty()) return false;
   if (!patch.curved) return true;
   // The plane through its centroid along its mean normal: noise on the normals averages out, and no fit
   // needs to read the points a second time.

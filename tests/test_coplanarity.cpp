@@ -29,6 +29,21 @@ SplitBox split_box(const Params& params = {}) {
 
 const Patch& patch(const Segmented& s, int i) { return s.result.patches[static_cast<size_t>(i)]; }
 
+// Two equal boxes with table between them, and the one top patch of each.
+struct TwoTops {
+  TestScene scene;
+  Segmented s;
+  std::vector<int> top1, top2;
+};
+
+TwoTops two_tops() {
+  TwoTops t{separate_boxes(), {}, {}, {}};
+  t.s = segment_scene(t.scene);
+  t.top1 = facing(t.s, patches_on(t.s, 1), direction_up(t.scene));
+  t.top2 = facing(t.s, patches_on(t.s, 2), direction_up(t.scene));
+  return t;
+}
+
 }  // namespace
 
 TEST(Coplanarity, OccludedFaceIsJoinedAcrossTheOccluder) {
@@ -52,10 +67,7 @@ TEST(Coplanarity, OccludedFaceIsJoinedAcrossTheOccluder) {
 }
 
 TEST(Coplanarity, TopsOfSeparateBoxesWithTableBetweenAreNotJoined) {
-  const TestScene scene = separate_boxes();
-  const Segmented s = segment_scene(scene);
-  const auto top1 = facing(s, patches_on(s, 1), direction_up(scene));
-  const auto top2 = facing(s, patches_on(s, 2), direction_up(scene));
+  const auto [scene, s, top1, top2] = two_tops();
   ASSERT_EQ(top1.size(), 1u);
   ASSERT_EQ(top2.size(), 1u);
   // Same height, parallel: only the occlusion check tells them apart.
@@ -136,10 +148,7 @@ TEST(Coplanarity, TouchingCoplanarTopsWithNothingInFrontStayApart) {
   // Two boxes' tops at one height. With the background test blinded (as when the gap between two touching
   // boxes shows nothing behind), flat tops are joined; tops that count as curved need an occluder in front
   // of the gap, and there is none.
-  const TestScene scene = separate_boxes();
-  const Segmented s = segment_scene(scene);
-  const auto top1 = facing(s, patches_on(s, 1), direction_up(scene));
-  const auto top2 = facing(s, patches_on(s, 2), direction_up(scene));
+  const auto [scene, s, top1, top2] = two_tops();
   ASSERT_EQ(top1.size(), 1u);
   ASSERT_EQ(top2.size(), 1u);
   Params::Coplanarity blind;
