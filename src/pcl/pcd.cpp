@@ -167,17 +167,23 @@ void check_header(const std::filesystem::path& path, const std::string& what) {
     if (key == "DATA") { data = true; break; }
   }
   if (!data) bad("no DATA line in the header");
-  // PCL's header parser reads on past DATA while lines start with a header keyword: a body that begins
-  // like one (COLUMNS, FIELDS, ...) redefines the fields and PCL reads out of bounds (found by fuzz_pcd).
+  // PCL's header parser reads on past DATA, skipping empty and comment lines, while lines start with a
+  // header keyword: a body that begins like one (COLUMNS, FIELDS, ...), after any comment lines, redefines
+  // the fields and PCL reads out of bounds (found by fuzz_pcd, twice). Read the body's first lines as PCL
+  // does (at most to the end of the file).
   {
     const std::streampos at = in.tellg();
-    std::string first;
-    std::getline(in, first);
-    std::istringstream words(first);
-    std::string token;
-    words >> token;
-    for (const char* key : {"VERSION", "FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"})
-      if (token.rfind(key, 0) == 0) bad("the body starts like a header line (" + printable(token) + ")");
+    std::string next;
+    while (std::getline(in, next)) {
+      if (next.empty()) continue;
+      std::istringstream words(next);
+      std::string token;
+      words >> token;
+      if (token.rfind('#', 0) == 0) continue;
+      for (const char* key : {"VERSION", "FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"})
+        if (token.rfind(key, 0) == 0) bad("the body starts like a header line (" + printable(token) + ")");
+      break;
+    }
     in.clear();
     in.seekg(at);
   }
