@@ -49,7 +49,7 @@ TEST(Reliability, FuzzedPcdFilesAreRefusedBeforePclReadsThem) {
   const std::vector<fs::path> named = {kBad / "pcd-fuzzed.pcd", kBad / "pcd-compressed-zero-size.pcd", kBad / "pcd-min.pcd",
                                        kBad / "pcd-lzf-damaged.pcd", kBad / "pcd-viewpoint-not-a-number.pcd",
                                        kBad / "pcd-body-like-a-header.pcd", kBad / "pcd-header-vertical-tab.pcd",
-                                       kBad / "pcd-comment-then-header.pcd"};
+                                       kBad / "pcd-comment-then-header.pcd", kBad / "pcd-header-tab-lines.pcd"};
   for (const fs::path& f : named) {
     const fs::path out = tmp / "out";
     const auto r = run_bounded("segment " + f.string() + " --fx 525 --out " + out.string(), tmp);

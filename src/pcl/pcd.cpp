@@ -139,21 +139,23 @@ void check_header(const std::filesystem::path& path, const std::string& what) {
   size_t next_key = 0;
   for (int i = 0; i < 64 && std::getline(in, line); ++i) {
     if (line.size() > 4096) bad("header line too long");
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    // PCL splits header lines at tab, CR and space only, but reads their first word with `>>`, which also
-    // skips vertical tabs and form feeds: on a line of such bytes the two disagree, and PCL's reader then
-    // dereferenced a null pointer (found by fuzz_pcd). PCL writes none of them.
+    if (line.empty()) continue;  // the only lines PCL skips besides comments ("\r" alone is not one)
+    if (line.back() == '\r') line.pop_back();
+    // PCL splits header lines at tab, CR and space only but reads their first word with `>>`, which also
+    // skips vertical tabs and form feeds, so the two disagree on words around such bytes. PCL writes none.
     const auto control = std::find_if(line.begin(), line.end(), [](unsigned char c) { return (c < 0x20 && c != '\t') || c == 0x7f; });
     if (control != line.end()) {
       char code[8];
       std::snprintf(code, sizeof code, "0x%02x", static_cast<unsigned char>(*control));
       bad("header line " + std::to_string(i + 1) + " holds the control character " + code);
     }
-    if (line.empty() || line[0] == '#') continue;
+    if (!line.empty() && line[0] == '#') continue;
     std::istringstream words(line);
     std::string key, word;
     words >> key;
-    if (key.empty()) continue;
+    // A line of blanks (or a lone CR) ends PCL's header where it stands, and its reader then dereferenced a
+    // null pointer (found by fuzz_pcd: lines of tabs or vertical tabs before VERSION).
+    if (key.empty()) bad("header line " + std::to_string(i + 1) + " holds only blanks");
     const auto known = std::find(kKeys.begin() + static_cast<std::ptrdiff_t>(next_key), kKeys.end(), key);
     if (known == kKeys.end()) {
       const bool listed = std::find(kKeys.begin(), kKeys.end(), key) != kKeys.end();
