@@ -8,7 +8,7 @@ namespace clutterseg {
 GapView view_gap(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const cv::Mat& points, const Camera& camera,
                  double tolerance) {
   if (points.empty() || a.z() <= 0 || b.z() <= 0) return {};
-  if (points.type() != CV_32FC3) throw Error("behind_fraction: points must be a CV_32FC3 image");
+  if (points.type() != CV_32FC3) throw Error("view_gap: points must be a CV_32FC3 image");
   const double fx = camera.fx, fy = camera.fy, cx = camera.cx, cy = camera.cy;
   const double ua = fx * a.x() / a.z() + cx, va = fy * a.y() / a.z() + cy;
   const double ub = fx * b.x() / b.z() + cx, vb = fy * b.y() / b.z() + cy;
