@@ -105,26 +105,70 @@ CLUTTERSEG_AVX2_KERNEL void centred_sums(const float* __restrict px, const float
   for (int k = 0; k < 10; ++k) total[k] += run[k];
 }
 
-// Lowest and highest values of axes * p over the valid points of a run (axes: row-major 3x3; points as
-// planes).
-CLUTTERSEG_ROW_KERNEL void extents_along(const float* __restrict px, const float* __restrict py,
-                                         const float* __restrict pz, int count, const float* __restrict axes,
-                                         float* __restrict low, float* __restrict high) {
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  float lo0 = low[0], lo1 = low[1], lo2 = low[2], hi0 = high[0], hi1 = high[1], hi2 = high[2];
-  const float a00 = axes[0], a01 = axes[1], a02 = axes[2], a10 = axes[3], a11 = axes[4], a12 = axes[5];
-  const float a20 = axes[6], a21 = axes[7], a22 = axes[8];
-#pragma omp simd reduction(min : lo0, lo1, lo2) reduction(max : hi0, hi1, hi2)
-  for (int k = 0; k < count; ++k) {
-    const bool valid = valid_depth(pz[k]);
-    const float c0 = a00 * px[k] + a01 * py[k] + a02 * pz[k], c1 = a10 * px[k] + a11 * py[k] + a12 * pz[k];
-    const float c2 = a20 * px[k] + a21 * py[k] + a22 * pz[k];
-    lo0 = std::min(lo0, valid ? c0 : kInf); hi0 = std::max(hi0, valid ? c0 : -kInf);
-    lo1 = std::min(lo1, valid ? c1 : kInf); hi1 = std::max(hi1, valid ? c1 : -kInf);
-    lo2 = std::min(lo2, valid ? c2 : kInf); hi2 = std::max(hi2, valid ? c2 : -kInf);
+// An object's lowest and highest values of axes * p (axes: rows of a row-major 3x3), per lane of 8. Min and
+// max need no order, so a run is read in whole blocks of 8 (its last block overlapping the one before): no
+// scalar tail and no merge of the lanes per run (runs are short, ~120 px at 640x480); the lanes are merged
+// once per object.
+constexpr int kLanes = 8;
+struct Extents {
+  float low[3][kLanes], high[3][kLanes];
+  Extents() {
+    for (int c = 0; c < 3; ++c) {
+      std::fill_n(low[c], kLanes, std::numeric_limits<float>::infinity());
+      std::fill_n(high[c], kLanes, -std::numeric_limits<float>::infinity());
+    }
   }
-  low[0] = lo0; low[1] = lo1; low[2] = lo2;
-  high[0] = hi0; high[1] = hi1; high[2] = hi2;
+  float lowest(int c) const { return *std::min_element(low[c], low[c] + kLanes); }
+  float highest(int c) const { return *std::max_element(high[c], high[c] + kLanes); }
+};
+
+using Float8 = float __attribute__((vector_size(32)));
+using Int8 = int __attribute__((vector_size(32)));
+
+// Adds the valid points of a run (as planes) to `extents`.
+CLUTTERSEG_AVX2_KERNEL void extents_along(const float* __restrict px, const float* __restrict py,
+                                         const float* __restrict pz, int count, const float* __restrict axes,
+                                         Extents& extents) {
+  if (count < kLanes) {  // a short run: one lane
+    for (int k = 0; k < count; ++k) {
+      if (!valid_depth(pz[k])) continue;
+      for (int c = 0; c < 3; ++c) {
+        const float v = axes[3 * c] * px[k] + axes[3 * c + 1] * py[k] + axes[3 * c + 2] * pz[k];
+        extents.low[c][0] = std::min(extents.low[c][0], v);
+        extents.high[c][0] = std::max(extents.high[c][0], v);
+      }
+    }
+    return;
+  }
+  Float8 low[3], high[3];
+  for (int c = 0; c < 3; ++c) {
+    std::memcpy(&low[c], extents.low[c], sizeof(Float8));
+    std::memcpy(&high[c], extents.high[c], sizeof(Float8));
+  }
+  const Float8 zero = {}, inf = zero + std::numeric_limits<float>::infinity();
+  const Float8 nan = zero + std::numeric_limits<float>::quiet_NaN();
+  const auto add_block = [&](int k) {
+    Float8 x, y, z;
+    std::memcpy(&x, px + k, sizeof x);
+    std::memcpy(&y, py + k, sizeof y);
+    std::memcpy(&z, pz + k, sizeof z);
+    // An invalid point (valid_depth, lane by lane) projects to NaN, which both compares below leave out.
+    const Int8 valid = (z > zero) & (z < inf);
+    x = valid ? x : nan;
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; ++c) {
+      const Float8 v = axes[3 * c] * x + axes[3 * c + 1] * y + axes[3 * c + 2] * z;
+      low[c] = v < low[c] ? v : low[c];
+      high[c] = high[c] < v ? v : high[c];
+    }
+  };
+  int k = 0;
+  for (; k + kLanes <= count; k += kLanes) add_block(k);
+  if (k < count) add_block(count - kLanes);
+  for (int c = 0; c < 3; ++c) {
+    std::memcpy(extents.low[c], &low[c], sizeof(Float8));
+    std::memcpy(extents.high[c], &high[c], sizeof(Float8));
+  }
 }
 
 // First and second moments of an object's points, summed relative to its first valid point (centred
@@ -181,18 +225,17 @@ void describe_shapes(std::vector<Object>& objects, const std::vector<char>& redo
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) axes_t[o][static_cast<size_t>(3 * r + c)] = static_cast<float>(axes[o](c, r));
   }
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  std::vector<Eigen::Vector3f> low(objects.size(), Eigen::Vector3f::Constant(kInf));
-  std::vector<Eigen::Vector3f> high(objects.size(), Eigen::Vector3f::Constant(-kInf));
+  std::vector<Extents> extents(objects.size());
   for (const auto& [o, begin, end] : runs) {
     const auto k = static_cast<size_t>(o);
     if (!redo[k]) continue;
-    extents_along(px + begin, py + begin, pz + begin, end - begin, axes_t[k].data(), low[k].data(), high[k].data());
+    extents_along(px + begin, py + begin, pz + begin, end - begin, axes_t[k].data(), extents[k]);
   }
   for (size_t o = 0; o < objects.size(); ++o) {
     if (!redo[o] || moments[o].valid() == 0) continue;
     // Axes ordered by extent, largest first, and right-handed.
-    const Eigen::Vector3d lo = low[o].cast<double>(), hi = high[o].cast<double>();
+    const Extents& e = extents[o];
+    const Eigen::Vector3d lo(e.lowest(0), e.lowest(1), e.lowest(2)), hi(e.highest(0), e.highest(1), e.highest(2));
     const Eigen::Vector3d extent = hi - lo;
     std::array<int, 3> order = {0, 1, 2};
     std::sort(order.begin(), order.end(), [&](int a, int b) { return extent(a) > extent(b); });
