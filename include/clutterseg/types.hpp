@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -49,8 +50,10 @@ inline float distance2(const cv::Vec3f& a, const cv::Vec3f& b) {
 }
 
 // End of the run of labels equal to lab[begin] within [begin, end). Label images come in long runs
-// (the row segments of patches and objects): sixteen labels per SSE2 test, then eight per step read as
-// four 64-bit words each holding two labels (the OR of differences is 0 only when all eight match).
+// (the row segments of patches and objects): sixteen labels per SSE2 test, and the test that fails gives
+// the end at once (the first lane that differs; runs are also many and short: edge bands, object rows);
+// near `end`, eight per step read as four 64-bit words each holding two labels (the OR of differences is 0
+// only when all eight match).
 inline int run_end(const int* lab, int begin, int end) {
   const int id = lab[begin];
   int k = begin + 1;
@@ -58,10 +61,12 @@ inline int run_end(const int* lab, int begin, int end) {
   const __m128i ids = _mm_set1_epi32(id);
   for (; k + 16 <= end; k += 16) {
     const auto* four = reinterpret_cast<const __m128i*>(lab + k);
-    const __m128i same = _mm_and_si128(
-        _mm_and_si128(_mm_cmpeq_epi32(_mm_loadu_si128(four), ids), _mm_cmpeq_epi32(_mm_loadu_si128(four + 1), ids)),
-        _mm_and_si128(_mm_cmpeq_epi32(_mm_loadu_si128(four + 2), ids), _mm_cmpeq_epi32(_mm_loadu_si128(four + 3), ids)));
-    if (_mm_movemask_epi8(same) != 0xFFFF) break;
+    const __m128i same[4] = {_mm_cmpeq_epi32(_mm_loadu_si128(four), ids), _mm_cmpeq_epi32(_mm_loadu_si128(four + 1), ids),
+                             _mm_cmpeq_epi32(_mm_loadu_si128(four + 2), ids), _mm_cmpeq_epi32(_mm_loadu_si128(four + 3), ids)};
+    if (_mm_movemask_epi8(_mm_and_si128(_mm_and_si128(same[0], same[1]), _mm_and_si128(same[2], same[3]))) == 0xFFFF) continue;
+    unsigned equal = 0;  // bit j: label k + j equals id
+    for (int q = 0; q < 4; ++q) equal |= static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(same[q]))) << (4 * q);
+    return k + std::countr_one(equal);
   }
 #endif
   const int two[2] = {id, id};
