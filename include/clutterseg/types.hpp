@@ -81,6 +81,12 @@ inline int run_end(const int* lab, int begin, int end) {
   return k;
 }
 
+// In a word of eight bytes read with memcpy, `marks` holding a set bit in each marked byte and none in
+// the bytes before the first marked one (in memory order): the index (0-7) of that first marked byte.
+// Little-endian only (the callers fall back to a byte loop elsewhere).
+inline int first_marked_byte(std::uint64_t marks) { return std::countr_zero(marks) / 8; }
+constexpr bool kLittleEndian = std::endian::native == std::endian::little;
+
 // First index in [from, end) where bytes[i] != 0, or end. Masks with few set bytes (pixels next to holes,
 // edge carriers) are skipped eight bytes per step.
 inline int first_nonzero(const std::uint8_t* bytes, int from, int end) {
@@ -88,7 +94,9 @@ inline int first_nonzero(const std::uint8_t* bytes, int from, int end) {
   for (; from + 8 <= end; from += 8) {
     std::uint64_t eight;
     std::memcpy(&eight, bytes + from, sizeof eight);
-    if (eight) break;
+    if (!eight) continue;
+    if constexpr (kLittleEndian) return from + first_marked_byte(eight);
+    break;
   }
   while (from < end && !bytes[from]) ++from;
   return from;
@@ -101,7 +109,11 @@ inline int first_zero(const std::uint8_t* bytes, int from, int end) {
   for (; from + 8 <= end; from += 8) {
     std::uint64_t eight;
     std::memcpy(&eight, bytes + from, sizeof eight);
-    if ((eight - kOnes) & ~eight & kHighs) break;  // some byte is 0 (exact, no false positive)
+    // The high bit of every zero byte; a byte after a zero one may be marked too (a borrow), none before.
+    const std::uint64_t zeros = (eight - kOnes) & ~eight & kHighs;
+    if (!zeros) continue;
+    if constexpr (kLittleEndian) return from + first_marked_byte(zeros);
+    break;
   }
   while (from < end && bytes[from]) ++from;
   return from;
