@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -66,7 +65,7 @@ inline int run_end(const int* lab, int begin, int end) {
     if (_mm_movemask_epi8(_mm_and_si128(_mm_and_si128(same[0], same[1]), _mm_and_si128(same[2], same[3]))) == 0xFFFF) continue;
     unsigned equal = 0;  // bit j: label k + j equals id
     for (int q = 0; q < 4; ++q) equal |= static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(same[q]))) << (4 * q);
-    return k + std::countr_one(equal);
+    return k + __builtin_ctz(~equal);  // the trailing ones (C++17: this header is also the ROS node's)
   }
 #endif
   const int two[2] = {id, id};
@@ -84,8 +83,8 @@ inline int run_end(const int* lab, int begin, int end) {
 // In a word of eight bytes read with memcpy, `marks` holding a set bit in each marked byte and none in
 // the bytes before the first marked one (in memory order): the index (0-7) of that first marked byte.
 // Little-endian only (the callers fall back to a byte loop elsewhere).
-inline int first_marked_byte(std::uint64_t marks) { return std::countr_zero(marks) / 8; }
-constexpr bool kLittleEndian = std::endian::native == std::endian::little;
+inline int first_marked_byte(std::uint64_t marks) { return __builtin_ctzll(marks) / 8; }
+constexpr bool kLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;  // C++17: no std::endian here
 
 // First index in [from, end) where bytes[i] != 0, or end. Masks with few set bytes (pixels next to holes,
 // edge carriers) are skipped eight bytes per step.
