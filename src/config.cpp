@@ -14,7 +14,7 @@ namespace clutterseg {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Smoothing, median, temporal, temporal_frames, temporal_band, scene_change_share)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Normals, step_px, smooth_ksize, noise_floor)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Edges, theta, step_px, jump_slope)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Patches, min_size_px, histogram_bins, occupied_share, flat_max_bins, split_band, seam_theta, seam_spread_deg)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Patches, min_size_px, metric_beyond_m, histogram_bins, occupied_share, flat_max_bins, split_band, seam_theta, seam_spread_deg)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Adjacency, radius_px, d_max)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::CutFree, enabled, planes, band, wrong_side_fraction, skip_angle_deg, skip_similar,
                                                 split_share)

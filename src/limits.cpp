@@ -49,6 +49,7 @@ void validate(const Params& p) {
   int_range("edges.step_px", p.edges.step_px, 1, 16);
   above("edges.jump_slope", p.edges.jump_slope, 0, 1e6);
   int_range("patches.min_size_px", p.patches.min_size_px, 1, 100000);
+  in_range("patches.metric_beyond_m", p.patches.metric_beyond_m, 0, 20);
   int_range("patches.histogram_bins", p.patches.histogram_bins, 2, 64);
   in_range("patches.occupied_share", p.patches.occupied_share, 0, 1);
   int_range("patches.flat_max_bins", p.patches.flat_max_bins, 1, 64 * 64);

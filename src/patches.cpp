@@ -126,6 +126,42 @@ int label_runs(const cv::Mat& edges, std::vector<LabelRun>& runs) {
 
 namespace {
 
+// A far component need cover only a quarter of min_size pixels (from twice metric_beyond_m on).
+constexpr int kFarShare = 4;
+
+// Which components become patches: those of at least min_size pixels and, beyond `beyond_m` (beyond the
+// paper; 0 = off), those covering the metric area that min_size pixels cover at `beyond_m`, judged at
+// their mean depth. A face's pixel count falls with z^2 while the edge band around it keeps its width in
+// pixels, so the faces of a far box would leave no patch of min_size inside them (docs/RESULTS.md
+// section 20). Only the components between min_size / kFarShare and min_size read their depths.
+std::vector<char> large_enough(const std::vector<LabelRun>& runs, const std::vector<ComponentSums>& sums,
+                               const cv::Mat& depth, int min_size, double beyond_m) {
+  std::vector<char> large(sums.size());
+  for (size_t c = 0; c < sums.size(); ++c) large[c] = sums[c].area >= min_size;
+  if (beyond_m <= 0) return large;
+  const auto candidate = [&](int c) {
+    const int area = sums[static_cast<size_t>(c)].area;
+    return area < min_size && kFarShare * area >= min_size;
+  };
+  std::vector<double> depth_sum(sums.size(), 0.0);
+  std::vector<int> measured(sums.size(), 0);
+  for (const LabelRun& run : runs) {
+    if (!candidate(run.component)) continue;
+    const float* z = depth.ptr<float>(run.y);
+    for (int x = run.x0; x < run.x1; ++x)
+      if (valid_depth(z[x])) {
+        depth_sum[static_cast<size_t>(run.component)] += z[x];
+        ++measured[static_cast<size_t>(run.component)];
+      }
+  }
+  for (size_t c = 1; c < sums.size(); ++c) {
+    if (measured[c] == 0 || !candidate(static_cast<int>(c))) continue;
+    const double z = depth_sum[c] / measured[c];
+    large[c] = sums[c].area * (z / beyond_m) * (z / beyond_m) >= min_size;
+  }
+  return large;
+}
+
 // extract_patches, and update_patches when `previous` is given: a component with exactly the pixels of
 // a previous patch takes that patch (moved), so only new components are measured.
 Patches build_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& camera, const NormalPlanes& normals,
@@ -164,8 +200,9 @@ Patches build_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& 
         same_as[static_cast<size_t>(run.component)] = old;
     }
   }
+  const std::vector<char> large = large_enough(runs, sums, depth, min_size, params.metric_beyond_m);
   const auto measured = [&](int component) {
-    return sums[static_cast<size_t>(component)].area >= min_size && same_as[static_cast<size_t>(component)] == 0;
+    return large[static_cast<size_t>(component)] && same_as[static_cast<size_t>(component)] == 0;
   };
   for (int c = 1; c < count; ++c)
     if (measured(c)) {
@@ -200,12 +237,12 @@ Patches build_patches(const cv::Mat& edges, const cv::Mat& depth, const Camera& 
     for (; k < n; ++k) ++counts[(k % kCounters) * cells + bin[static_cast<size_t>(k)]];
   }
 
-  // Components of at least min_size pixels become patches 1..N, in raster order.
+  // Components large enough become patches 1..N, in raster order.
   std::vector<int> new_id(static_cast<size_t>(count), 0);
   Patches out;
   for (int c = 1; c < count; ++c) {
     ComponentSums& s = sums[static_cast<size_t>(c)];
-    if (s.area < min_size) continue;
+    if (!large[static_cast<size_t>(c)]) continue;
     new_id[static_cast<size_t>(c)] = static_cast<int>(out.patches.size()) + 1;
     if (const int old = same_as[static_cast<size_t>(c)]; old > 0) {
       out.patches.push_back(std::move(previous->patches[static_cast<size_t>(old - 1)]));

@@ -229,6 +229,27 @@ TEST(Patches, SmallComponentsAreDropped) {
   EXPECT_THROW(extract_patches(edges, depth(cv::Rect(0, 0, 40, 30)), synth::default_camera(40, 40), nrm, {}, 10), Error);
 }
 
+// A face's pixel count falls with z^2: beyond metric_beyond_m a component needs only the metric area
+// min_size covers there, and never less than a quarter of min_size pixels.
+TEST(Patches, AFarFaceNeedsOnlyTheMetricAreaOfMinSize) {
+  const auto patches_of = [](double z, int side, double beyond_m) {
+    cv::Mat edges(40, 40, CV_8U, cv::Scalar(255));
+    edges(cv::Rect(5, 5, side, side)).setTo(0);  // one face of side x side pixels, edges around it
+    const cv::Mat depth(40, 40, CV_32F, cv::Scalar(z));
+    const NormalPlanes nrm = {cv::Mat(40, 40, CV_32F, cv::Scalar(0)), cv::Mat(40, 40, CV_32F, cv::Scalar(0)),
+                              cv::Mat(40, 40, CV_32F, cv::Scalar(-1))};
+    Params::Patches params;
+    params.metric_beyond_m = beyond_m;
+    return extract_patches(edges, depth, synth::default_camera(40, 40), nrm, params, 200).patches.size();
+  };
+  EXPECT_EQ(patches_of(2.0, 10, 1.3), 1u);   // 100 px at 2 m cover what 237 px cover at 1.3 m
+  EXPECT_EQ(patches_of(2.0, 10, 0.0), 0u);   // off: min_size pixels at every depth
+  EXPECT_EQ(patches_of(1.5, 10, 1.3), 0u);   // 100 px at 1.5 m: 133 px at 1.3 m, too small
+  EXPECT_EQ(patches_of(1.0, 10, 1.3), 0u);   // nearer than 1.3 m: pixels only
+  EXPECT_EQ(patches_of(1.0, 15, 1.3), 1u);   // 225 px
+  EXPECT_EQ(patches_of(4.0, 7, 1.3), 0u);    // 49 px, below a quarter of min_size however far
+}
+
 TEST(Patches, AreTheFourConnectedComponentsOfTheNonEdgePixels) {
   // Patches come from runs of non-edge pixels joined across rows. With a minimum size of 1 every
   // component is a patch, and the patch image must be OpenCV's 4-connected labelling, numbering

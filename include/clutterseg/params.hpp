@@ -43,6 +43,10 @@ struct Params {
   // c) Surface patches = 4-connected components of non-edge pixels.
   struct Patches {
     int min_size_px = 50;        // smallest patch at 320x240 [px], scaled (PixelScale)
+    double metric_beyond_m = 1.3;  // beyond the paper: a component farther than this (mean depth) needs
+                                 // only the metric area min_size_px covers at this depth, and at least a
+                                 // quarter of min_size_px: far faces keep patches inside their edge band
+                                 // [m]; 0 = min_size_px at every depth
     int histogram_bins = 11;     // normal (x, y) histogram bins per axis
     double occupied_share = 0.005;  // a histogram bin counts as occupied above this share [-]
     int flat_max_bins = 8;       // a patch is flat when fewer bins than this are occupied
