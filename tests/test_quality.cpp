@@ -1,6 +1,6 @@
-// Segmentation quality on real frames, held to what docs/RESULTS.md reports (issue 14): the hand-labelled
-// osd-kinect frames of data/handlabelled/ and the YCB-Video frames. A change that merges objects again,
-// keeps table in an object or drops object faces fails here.
+// Segmentation quality, held to what docs/RESULTS.md reports (issue 14): the hand-labelled osd-kinect
+// frames of data/handlabelled/, the YCB-Video frames and the synthetic Table II families. A change that
+// merges objects again, keeps table in an object or drops object faces fails here.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -9,6 +9,7 @@
 #include "clutterseg/io.hpp"
 #include "clutterseg/objects.hpp"
 #include "clutterseg/segmenter.hpp"
+#include "clutterseg/synth/dataset.hpp"
 
 using namespace clutterseg;
 namespace fs = std::filesystem;
@@ -20,6 +21,23 @@ struct Totals {
   int frames = 0, merged_objects = 0;
 };
 
+void add(Totals& t, const cv::Mat& truth, const Result& r) {
+  const cv::Mat view = objects_only(r.object_labels, r.objects);
+  const FrameScores s = score_frame(truth, view);
+  const ErrorBreakdown b = error_breakdown(truth, view, s.matches);
+  t.overlap_f += s.overlap_f;
+  t.tp += s.tp;
+  t.fp += s.fp;
+  t.background += b.background;
+  t.dropped += b.dropped;
+  t.merged_objects += b.merged_objects;
+  ++t.frames;
+}
+
+void average(Totals& t) {
+  for (double* v : {&t.overlap_f, &t.tp, &t.fp, &t.background, &t.dropped}) *v /= std::max(1, t.frames);
+}
+
 // Each frame on its own (no temporal history), in the objects-only view, as `clutterseg eval` scores it.
 Totals score(const fs::path& depth_dir, const fs::path& label_dir, const Camera& camera, bool stream) {
   Totals t;
@@ -29,21 +47,9 @@ Totals score(const fs::path& depth_dir, const fs::path& label_dir, const Camera&
   std::vector<fs::path> frames;
   for (const auto& e : fs::directory_iterator(label_dir)) frames.push_back(e.path().filename());
   std::sort(frames.begin(), frames.end());
-  for (const auto& name : frames) {
-    const Result r = segmenter.segment(read_depth_png(depth_dir / name), camera);
-    const cv::Mat view = objects_only(r.object_labels, r.objects);
-    const cv::Mat truth = read_label_png(label_dir / name);
-    const FrameScores s = score_frame(truth, view);
-    const ErrorBreakdown b = error_breakdown(truth, view, s.matches);
-    t.overlap_f += s.overlap_f;
-    t.tp += s.tp;
-    t.fp += s.fp;
-    t.background += b.background;
-    t.dropped += b.dropped;
-    t.merged_objects += b.merged_objects;
-    ++t.frames;
-  }
-  for (double* v : {&t.overlap_f, &t.tp, &t.fp, &t.background, &t.dropped}) *v /= std::max(1, t.frames);
+  for (const auto& name : frames)
+    add(t, read_label_png(label_dir / name), segmenter.segment(read_depth_png(depth_dir / name), camera));
+  average(t);
   return t;
 }
 
@@ -103,4 +109,34 @@ TEST(Quality, TheRealsenseTableStaysTheSupport) {
   ASSERT_TRUE(valid_point(canister));
   EXPECT_GT(r.support_plane->distance({canister[0], canister[1], canister[2]}), 0.05f);
   EXPECT_GT(view.at<int>(250, 250), 0) << "the canister is labelled table or background";
+}
+
+// The paper's Table II families as `scripts/synth_table2.sh out/table2 20 11` writes them (Kinect v1,
+// 640x480, seed 11, 20 frames each), scored as `clutterseg eval` scores them: docs/RESULTS.md, "Synthetic
+// scenes with exact labels" (boxes 95.8 / 2.5 / 97.2, stacked boxes 91.4 / 4.6 / 93.6, occluded 87.4 / 5.4 /
+// 93.1, cylinders 95.2 / 1.5 / 96.9, mixed 94.5 / 2.5 / 95.6, complex 89.2 / 6.2 / 93.9: tp / fp / Overlap F).
+// Issue 14's targets where they are met (tp >= 90, fp <= 5), a point of slack elsewhere.
+TEST(Quality, SyntheticTableIIFamilies) {
+  struct Family {
+    const char* name;
+    double min_tp, max_fp;
+  };
+  const Family families[] = {{"boxes", 0.90, 0.05},    {"stacked-boxes", 0.90, 0.05}, {"occluded", 0.86, 0.065},
+                             {"cylinders", 0.90, 0.05}, {"mixed", 0.90, 0.05},         {"complex", 0.88, 0.072}};
+  const Camera camera = synth::default_camera();
+  Params p;
+  p.smoothing.temporal = false;
+  for (const Family& family : families) {
+    Totals t;
+    Segmenter segmenter(p);
+    for (int frame = 0; frame < 20; ++frame) {
+      const synth::SynthFrame f = synth::synthesize(family.name, 11, frame, camera, synth::Sensor::KinectV1);
+      add(t, f.sensor.labels, segmenter.segment(f.sensor.depth_mm, camera));
+    }
+    average(t);
+    EXPECT_GE(t.tp, family.min_tp) << family.name;
+    EXPECT_LE(t.fp, family.max_fp) << family.name;
+    EXPECT_GE(t.overlap_f, 0.92) << family.name;
+    std::printf("%-14s tp %.1f fp %.1f Overlap F %.1f\n", family.name, 100 * t.tp, 100 * t.fp, 100 * t.overlap_f);
+  }
 }
