@@ -144,19 +144,19 @@ std::vector<char> large_enough(const std::vector<LabelRun>& runs, const std::vec
     return area < min_size && kFarShare * area >= min_size;
   };
   std::vector<double> depth_sum(sums.size(), 0.0);
-  std::vector<int> measured(sums.size(), 0);
+  std::vector<int> with_depth(sums.size(), 0);
   for (const LabelRun& run : runs) {
     if (!candidate(run.component)) continue;
     const float* z = depth.ptr<float>(run.y);
     for (int x = run.x0; x < run.x1; ++x)
       if (valid_depth(z[x])) {
         depth_sum[static_cast<size_t>(run.component)] += z[x];
-        ++measured[static_cast<size_t>(run.component)];
+        ++with_depth[static_cast<size_t>(run.component)];
       }
   }
   for (size_t c = 1; c < sums.size(); ++c) {
-    if (measured[c] == 0 || !candidate(static_cast<int>(c))) continue;
-    const double z = depth_sum[c] / measured[c];
+    if (with_depth[c] == 0 || !candidate(static_cast<int>(c))) continue;
+    const double z = depth_sum[c] / with_depth[c];
     large[c] = sums[c].area * (z / beyond_m) * (z / beyond_m) >= min_size;
   }
   return large;

@@ -21,6 +21,7 @@ struct Totals {
   int frames = 0, merged_objects = 0;
 };
 
+// One frame's scores added to `t`, in the objects-only view, as `clutterseg eval` scores it.
 void add(Totals& t, const cv::Mat& truth, const Result& r) {
   const cv::Mat view = objects_only(r.object_labels, r.objects);
   const FrameScores s = score_frame(truth, view);
@@ -34,11 +35,12 @@ void add(Totals& t, const cv::Mat& truth, const Result& r) {
   ++t.frames;
 }
 
+// Sums to means over the frames.
 void average(Totals& t) {
   for (double* v : {&t.overlap_f, &t.tp, &t.fp, &t.background, &t.dropped}) *v /= std::max(1, t.frames);
 }
 
-// Each frame on its own (no temporal history), in the objects-only view, as `clutterseg eval` scores it.
+// The frames of a folder, each on its own (no temporal history) unless `stream`.
 Totals score(const fs::path& depth_dir, const fs::path& label_dir, const Camera& camera, bool stream) {
   Totals t;
   Params p;
