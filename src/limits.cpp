@@ -86,6 +86,7 @@ void validate(const Params& p) {
   in_range("remaining.grow_distance", p.remaining.grow_distance, 0, 1);
   in_range("remaining.gap_px", p.remaining.gap_px, 0, 16);
   int_range("remaining.tiny_px", p.remaining.tiny_px, 0, 100000);
+  in_range("remaining.min_contact_share", p.remaining.min_contact_share, 0, 1);
   int_range("remaining.hole_px", p.remaining.hole_px, 0, 1000);
   in_range("remaining.shadow_baseline", p.remaining.shadow_baseline, -1, 1);
   in_range("remaining.occluded_jump", p.remaining.occluded_jump, 0, 1);

@@ -22,6 +22,8 @@
 // - Beyond the paper: in rules 2-3 a segment seen behind its one face across depth jumps (most of its
 //   contacts with it, Params::Remaining::occluded_jump) and nowhere within the jump of it in space is an
 //   object that face hides, not a part of it. In rule 5 a face it is seen behind takes none of it.
+// - Beyond the paper: in rule 3 a segment whose one face holds less than Params::Remaining::min_contact_share of
+//   its ring (a pan's wall without a patch that grazes a cup beside it) is an object of its own, not a part of it.
 // - Beyond the paper: in rules 1-3 a segment that would be an object of its own (hidden behind its one face,
 //   or cut off from every face by missing depth) joins the object on whose nearby faces' planes it lies, with
 //   only nearer things between (the co-planarity cue f/g for a segment; Params::Remaining::hidden_coplanar_band).
@@ -398,8 +400,10 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const bool enclosed = !touches_border && other_segment == 0 && face.ring >= invalid;  // rule 3
       // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
       // near it in space, the segment is an object that face hides, not a part of it.
+      // Beyond the paper: touching its one face in a pixel or two of its ring, the segment is no part of it.
+      const bool grazing = face.ring < params.min_contact_share * static_cast<double>(ring.size());
       if (!tiny && hidden_by(face)) set_all(hidden_object(face));
-      else set_all(!tiny && enclosed ? ++next_object : object_of(face.label));
+      else set_all(!tiny && (enclosed || grazing) ? ++next_object : object_of(face.label));
       continue;
     }
     // Beyond the paper: a face the segment is seen behind (most of their contacts across a jump) hides it and

@@ -116,7 +116,7 @@ TEST(Quality, TheRealsenseTableStaysTheSupport) {
 // The paper's Table II families as `scripts/synth_table2.sh out/table2 20 11` writes them (Kinect v1,
 // 640x480, seed 11, 20 frames each), scored as `clutterseg eval` scores them: docs/RESULTS.md, "Synthetic
 // scenes with exact labels" (boxes 95.8 / 2.5 / 97.2, stacked boxes 91.4 / 4.6 / 93.6, occluded 87.4 / 5.4 /
-// 93.1, cylinders 95.2 / 1.5 / 96.9, mixed 94.5 / 2.5 / 95.6, complex 89.2 / 6.2 / 93.9: tp / fp / Overlap F).
+// 93.1, cylinders 95.2 / 1.5 / 96.9, mixed 94.5 / 1.7 / 96.0, complex 89.2 / 6.2 / 93.9: tp / fp / Overlap F).
 // Issue 14's targets where they are met (tp >= 90, fp <= 5), a point of slack elsewhere.
 TEST(Quality, SyntheticTableIIFamilies) {
   struct Family {

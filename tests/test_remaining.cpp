@@ -82,6 +82,29 @@ TEST(Remaining, Rule3EnclosedBecomesObjectElseJoins) {
   EXPECT_EQ(e.run({0}, 1).at<int>(14, 18), 2);
 }
 
+// Beyond the paper (Params::Remaining::min_contact_share): a segment that touches its one face in a single
+// ring pixel (a pan's wall without a patch grazing a cup beside it) is an object of its own; one that shares
+// an edge with the face joins it, as in the paper's rule 3.
+TEST(Remaining, ASegmentGrazingItsOneFaceIsAnObjectOfItsOwn) {
+  const auto run = [](int segment_x, double share) {
+    cv::Mat depth(60, 80, CV_32F, cv::Scalar(0.f)), labels(60, 80, CV_32S, cv::Scalar(0));
+    depth(cv::Rect(0, 0, 20, 20)).setTo(1.f);  // the face: patch 1
+    labels(cv::Rect(0, 0, 20, 20)).setTo(1);
+    depth(cv::Rect(segment_x, 20, 50, 30)).setTo(1.f);  // the segment, below and right of it, no depth around
+    Camera camera = Case::camera();
+    camera.cx = 40;
+    camera.cy = 30;
+    camera.width = 80;
+    camera.height = 60;
+    Params::Remaining params;
+    params.min_contact_share = share;
+    return assign_remaining(labels, {0}, 1, depth_to_points(depth, camera), NormalPlanes{}, params, 20).at<int>(35, 45);
+  };
+  EXPECT_EQ(run(20, 0.01), 2);  // one diagonal contact in a ring of about 160 pixels: an object
+  EXPECT_EQ(run(20, 0.0), 1);   // the paper's rule 3: joins
+  EXPECT_EQ(run(5, 0.01), 1);   // 16 contacts along the face's lower edge: part of it
+}
+
 // Beyond the paper (Params::Remaining::occluded_jump): a segment seen behind its one face across a depth
 // jump is an object that face hides (a box nearly hidden behind a taller one), not a part of the face; in
 // front of it, or behind by less than the jump, it joins the face as in rule 3. So does a segment that meets

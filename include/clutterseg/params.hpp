@@ -148,6 +148,10 @@ struct Params {
                                  // face seen at a grazing angle, where a Kinect drops most pixels, stays one
                                  // segment instead of specks; at 320x240 [px], scaled; 0 = 8-connected only
     int tiny_px = 20;            // "very few points" at 320x240 [px], scaled (PixelScale)
+    double min_contact_share = 0.01;  // beyond the paper: in rule 3 a segment (not tiny, not enclosed) joins
+                                 // its one neighbouring face only when that face holds at least this share of
+                                 // the segment's ring; touching it in a pixel or two (a pan's wall without a
+                                 // patch grazing a cup) it is an object of its own [-]; 0 = the paper's rule
     int hole_px = 4;             // beyond the paper: a run of pixels without depth at most this long
                                  // with one object on both ends (row or column) is that object's
                                  // (holes.hpp); at 320x240 [px], scaled; 0 = pixels without depth stay 0
