@@ -398,10 +398,10 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const bool tiny = static_cast<int>(seg_pixels.size()) < tiny_px;          // rule 2
       const Face& face = faces[0];
       const bool enclosed = !touches_border && other_segment == 0 && face.ring >= invalid;  // rule 3
-      // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
-      // near it in space, the segment is an object that face hides, not a part of it.
       // Beyond the paper: touching its one face in a pixel or two of its ring, the segment is no part of it.
       const bool grazing = face.ring < params.min_contact_share * static_cast<double>(ring.size());
+      // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
+      // near it in space, the segment is an object that face hides, not a part of it.
       if (!tiny && hidden_by(face)) set_all(hidden_object(face));
       else set_all(!tiny && (enclosed || grazing) ? ++next_object : object_of(face.label));
       continue;
