@@ -102,7 +102,7 @@ CLUTTERSEG_ROW_KERNEL int mark_roles(const int* __restrict labels, const uchar* 
   int count = 0;
   for (int i = 0; i < total; ++i) {
     const int l = labels[i];
-    role[i] = (l > 0) & (l <= num_patches) & (has_depth[i] != 0) ? source : neither;
+    role[i] = ((l > 0) & (l <= num_patches) & (has_depth[i] != 0)) ? source : neither;
     carrier[i] = (l == 0) & (near_depth[i] != 0);
     count += carrier[i];
   }
