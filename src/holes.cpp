@@ -82,7 +82,7 @@ int fill_depth_holes(cv::Mat& object_labels, const cv::Mat& depth, std::vector<O
       _mm_storeu_si128(reinterpret_cast<__m128i*>(h + x), bytes);
     }
 #endif
-    for (; x < cols; ++x) h[x] = (d[x] > 0.f) | (lab[x] != 0) ? 0 : 255;
+    for (; x < cols; ++x) h[x] = ((d[x] > 0.f) | (lab[x] != 0)) ? 0 : 255;
   }
   constexpr std::uint64_t kAllHoles = ~std::uint64_t{0};
   const std::vector<uchar> no_holes(static_cast<size_t>(cols), 0);  // `above` for the row scan's test

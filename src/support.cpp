@@ -495,7 +495,7 @@ CLUTTERSEG_ROW_KERNEL int mark_above_plane(const float* __restrict xyz, int n, f
   int count = 0;
   for (int i = 0; i < n; ++i) {
     const float x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
-    const bool is_above = valid_depth(z) & (a * x + b * y + c * z + d > k * std::max(1.f, z * z));
+    const int is_above = int{valid_depth(z)} & int{a * x + b * y + c * z + d > k * std::max(1.f, z * z)};
     above[i] = is_above ? 255 : 0;
     count += is_above;
   }
