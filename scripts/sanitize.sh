@@ -11,8 +11,7 @@ jobs="${JOBS:-$(nproc)}"
 CXX_SAN="clang++-14"
 common=(-G Ninja -DCMAKE_CXX_COMPILER="$CXX_SAN" -DCMAKE_C_COMPILER=clang-14 -DCMAKE_BUILD_TYPE=Sanitize
         -DCLUTTERSEG_WITH_PYTHON=OFF -DCLUTTERSEG_WITH_ROS=OFF -DCLUTTERSEG_BUILD_BENCH=OFF)
-# -O0 (the library, the PCD reader and the scene renderer get -O1 from CMakeLists.txt): half the compile
-# time of -O1.
+# -O0 (the library and the PCD reader get -O1 from CMakeLists.txt): half the compile time of -O1.
 # Line tables only: reports still name file and line, and each file compiles ~20 % faster than with -g.
 # -Wno-pass-failed: at -O1 clang does not vectorize the `omp simd` loops, and says so for each.
 quiet="-Wno-pass-failed"
