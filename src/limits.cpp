@@ -99,6 +99,7 @@ void validate(const Params& p) {
   in_range("support.region_margin", p.support.region_margin, 0, 10);
   in_range("support.wall_min_extent", p.support.wall_min_extent, 0, 100);
   in_range("support.wall_hides_share", p.support.wall_hides_share, 0, 1);
+  in_range("support.glued_share", p.support.glued_share, 0, 1);
   in_range("support.enclosed_share", p.support.enclosed_share, 0, 1);
   in_range("support.curved_bins_ratio", p.support.curved_bins_ratio, 0, 1000);
   int_range("tracking.max_missed", p.tracking.max_missed, 0, 100000);

@@ -21,6 +21,9 @@ namespace {
 
 Eigen::Vector3f point_at(const cv::Vec3f* pts, int i) { return {pts[i][0], pts[i][1], pts[i][2]}; }
 
+// Params::Support::glued_share is on: a table with objects glued to it is found and cut (beyond the paper).
+bool glued(const Params::Support& params) { return params.glued_share > 0; }
+
 // Largest a * x + b * y over the points, a and b in {-1, 0, 1} (exact: no rounding but the one sum).
 CLUTTERSEG_ROW_KERNEL float largest_projection(const float* __restrict x, const float* __restrict y, int n, float a,
                                                float b) {
@@ -239,17 +242,18 @@ bool refit(const std::vector<Patch>& patches, const std::vector<int>& table, con
 
 // A patch a plane's refit is made from: normal close to the plane's, half of the points within the
 // tolerance (a patch that holds an object's foot still counts).
-bool is_near(const Patch& patch, const cv::Mat& points, const Plane& plane, const Params::Support& params) {
+bool is_near(const Patch& patch, const cv::Mat& points, const Plane& plane, const Params::Support& params,
+             double share = 0.5) {
   const float min_cos = static_cast<float>(std::cos(params.table_angle_deg * M_PI / 180.0));
-  return patch.mean_normal.dot(plane.normal) >= min_cos && mostly_within(patch.pixels, points, plane, params.plane_band, 0.5);
+  return patch.mean_normal.dot(plane.normal) >= min_cos && mostly_within(patch.pixels, points, plane, params.plane_band, share);
 }
 
 // The patches that are is_near the plane.
 std::vector<int> patches_near(const std::vector<Patch>& patches, const cv::Mat& points, const Plane& plane,
-                              const Params::Support& params) {
+                              const Params::Support& params, double share = 0.5) {
   std::vector<int> near;
   for (size_t p = 0; p < patches.size(); ++p)
-    if (is_near(patches[p], points, plane, params)) near.push_back(static_cast<int>(p));
+    if (is_near(patches[p], points, plane, params, share)) near.push_back(static_cast<int>(p));
   return near;
 }
 
@@ -364,7 +368,8 @@ std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const
   size_t patch_pixels = 0;
   for (const auto& p : patches) patch_pixels += p.pixels.size();
   // The 4 largest planar patches with >= 2 % of the patch pixels, judged largest first (ties: lower
-  // index), so RANSAC runs only until 4 are found; those facing up are the candidates.
+  // index), so RANSAC runs only until 4 are found; those facing up are the candidates. Planar: 60 % of
+  // the points on one plane, or glued_share of them (a table with objects glued to it, beyond the paper).
   std::vector<int> by_size;
   for (size_t p = 0; p < patches.size(); ++p)
     if (static_cast<double>(patches[p].pixels.size()) >= 0.02 * static_cast<double>(patch_pixels)) by_size.push_back(static_cast<int>(p));
@@ -376,11 +381,12 @@ std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const
   // camera looking straight down sees the table's normal at 90 deg from the image's up).
   const Eigen::Vector3f up = up_in_camera(camera);
   const float min_up = camera.camera_to_robot.isIdentity() ? -0.1f : static_cast<float>(std::cos(M_PI / 4));
+  const double min_share = glued(params) ? std::min(0.6, params.glued_share) : 0.6;
   std::vector<int> candidates, large_planes;  // the 4 largest planes; those facing up are candidates
   std::vector<Plane> planes;
   for (size_t k = 0; k < by_size.size() && large_planes.size() < 4; ++k) {
     Plane plane;
-    if (dominant_plane(patches[static_cast<size_t>(by_size[k])].pixels, points, params.plane_band, plane) < 0.6) continue;
+    if (dominant_plane(patches[static_cast<size_t>(by_size[k])].pixels, points, params.plane_band, plane) < min_share) continue;
     large_planes.push_back(by_size[k]);
     if (plane.normal.dot(up) < min_up) continue;  // a wall seen from above, a ceiling: nothing stands on them
     candidates.push_back(by_size[k]);
@@ -434,14 +440,20 @@ std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const
   // Refit over every patch lying in the plane, twice: the second pass sees the pieces the first one's
   // better plane brings within the tolerance. A refit that no longer holds the patch it started from is
   // not the table seen better but pulled away by far pieces (their tolerance grows with depth, and far
-  // points tilt a least-squares plane most): the plane before it stays (tabletop-realsense 000008).
-  const Patch& seed = patches[static_cast<size_t>(candidates[static_cast<size_t>(best)])];
+  // points tilt a least-squares plane most): the plane before it stays (tabletop-realsense 000008). A
+  // table with objects glued to it holds less than half its points in the plane; its points within the
+  // tolerance are part of every refit, and it must keep glued_share of them.
+  const int seed_index = candidates[static_cast<size_t>(best)];
+  const Patch& seed = patches[static_cast<size_t>(seed_index)];
+  const double seed_share = glued(params) ? std::min(0.5, params.glued_share) : 0.5;
   Plane plane = planes[static_cast<size_t>(best)];
   for (int pass = 0; pass < 2; ++pass) {
-    const std::vector<int> near = patches_near(patches, points, plane, params);
+    std::vector<int> near = patches_near(patches, points, plane, params);
+    if (glued(params) && !std::binary_search(near.begin(), near.end(), seed_index))
+      near.insert(std::lower_bound(near.begin(), near.end(), seed_index), seed_index);
     Plane refitted = plane;
     if (near.empty() || !refit(patches, near, points, params.plane_band, refitted) ||
-        !is_near(seed, points, refitted, params))
+        !is_near(seed, points, refitted, params, seed_share))
       break;
     plane = refitted;
   }
@@ -488,16 +500,17 @@ std::vector<int> off_plane(const std::vector<int>& pixels, const cv::Vec3f* pts,
 
 namespace {
 
-// above[i] = 255 where point i (interleaved xyz) is valid and higher above the plane than k * max(1, z^2);
-// returns how many are.
-CLUTTERSEG_ROW_KERNEL int mark_above_plane(const float* __restrict xyz, int n, float a, float b, float c, float d,
-                                           float k, uchar* __restrict above) {
+// off[i] = 255 where point i (interleaved xyz) is valid and higher above the plane than k * max(1, z^2)
+// (or, with `below`, farther from it on either side); returns how many are.
+CLUTTERSEG_ROW_KERNEL int mark_off_plane(const float* __restrict xyz, int n, float a, float b, float c, float d,
+                                         float k, bool below, uchar* __restrict off) {
   int count = 0;
   for (int i = 0; i < n; ++i) {
     const float x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
-    const int is_above = int{valid_depth(z)} & int{a * x + b * y + c * z + d > k * std::max(1.f, z * z)};
-    above[i] = is_above ? 255 : 0;
-    count += is_above;
+    const float h = a * x + b * y + c * z + d, tolerance = k * std::max(1.f, z * z);
+    const int is_off = int{valid_depth(z)} & (int{h > tolerance} | (int{below} & int{h < -tolerance}));
+    off[i] = is_off ? 255 : 0;
+    count += is_off;
   }
   return count;
 }
@@ -525,27 +538,29 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
   // line; the mark image is made only for a patch to cut (most frames have none).
   const auto* xyz = points.ptr<float>();
   std::array<uchar, 1024> scratch;  // marks of a piece of a run when only counting
-  // Pixels of `pixels` clear of the plane, marked in `image` (nullptr: counted only). Runs go in pieces
-  // that fit the scratch line (a run crosses rows where a patch spans them).
-  const auto above = [&](const std::vector<int>& pixels, uchar* image) {
+  // Pixels of `pixels` clear of the plane (above it; either side when glued_share is on: the floor past
+  // the table's edge), marked in `image` (nullptr: counted only). Runs go in pieces that fit the scratch
+  // line (a run crosses rows where a patch spans them).
+  const auto clear_of = [&](const std::vector<int>& pixels, uchar* image) {
     int count = 0;
     constexpr int kPiece = static_cast<int>(scratch.size());
     for_each_pixel_run(pixels, [&](int first, int n) {
       for (int begin = first; begin < first + n; begin += kPiece)
-        count += mark_above_plane(xyz + 3 * static_cast<size_t>(begin), std::min(kPiece, first + n - begin),
-                                  plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset,
-                                  static_cast<float>(params.plane_band), image ? image + begin : scratch.data());
+        count += mark_off_plane(xyz + 3 * static_cast<size_t>(begin), std::min(kPiece, first + n - begin),
+                                plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset,
+                                static_cast<float>(params.plane_band), glued(params), image ? image + begin : scratch.data());
     });
     return count;
   };
   cv::Mat clear;  // core pixels of table patches clear of the plane
   int cut = 0;
-  for (const int p : patches_near(patches, points, plane, params)) {
+  const double share = glued(params) ? std::min(0.5, params.glued_share) : 0.5;  // of points in the plane
+  for (const int p : patches_near(patches, points, plane, params, share)) {
     const auto& pixels = patches[static_cast<size_t>(p)].pixels;
-    const int count = above(pixels, nullptr);
+    const int count = clear_of(pixels, nullptr);
     if (count < min_px) continue;
     if (clear.empty()) clear = cv::Mat(patch_labels.size(), CV_8U, cv::Scalar(0));
-    above(pixels, clear.ptr<uchar>());
+    clear_of(pixels, clear.ptr<uchar>());
     cut += count;
   }
   if (cut > 0) separate_marked(edges, clear, patch_labels);

@@ -50,6 +50,75 @@ TEST(Support, TheTableNotTheLargerFloorBelowIt) {
   EXPECT_GT(std::abs(s.result.support_plane->distance(floor_point)), 0.2f);
 }
 
+// Beyond the paper (support.glued_share): depth smoothed so much (filtered stereo: tabletop-realsense 000005
+// and 000006) that no edge band is left around a box on the table or along the table's front edge. One patch
+// holds the table, that box and the floor seen in front of the table (less than 60 % of it on one plane);
+// the rest of the floor is a larger planar patch, and a second box on the table a patch of its own.
+TEST(Support, ATableGluedToABoxAndTheFloorIsFoundAndCutFromThem) {
+  Shape floor = table(1.5);
+  floor.pose = Eigen::Translation3d(0, 0, -0.3);
+  floor.label = 9;
+  TestScene scene{{{floor, table(0.2), box(1, {-0.05, -0.02, 0.07}, {0.1, 0.06, 0.07}), box(2, {0.12, 0.08, 0.04}, {0.03, 0.03, 0.04})}}};
+  const auto truth = scene.render();
+  const cv::Mat points = depth_to_points(truth.depth, scene.camera);
+  const int* label = truth.labels.ptr<int>();
+  const int width = truth.depth.cols;
+  int table_bottom = 0;  // the lowest image row of the table
+  for (int i = 0; i < static_cast<int>(truth.depth.total()); ++i)
+    if (label[i] == 0 && truth.depth.ptr<float>()[i] > 0) table_bottom = std::max(table_bottom, i / width);
+  // The floor glued to the table: a strip of 8 rows below the table's front edge. The patch is then half
+  // table, 30 % box and 20 % floor.
+  const auto in_front = [&](int i) { return i / width > table_bottom && i / width <= table_bottom + 8; };
+  std::vector<int> glued, rest_of_floor, small_box;
+  for (int i = 0; i < static_cast<int>(truth.depth.total()); ++i) {
+    if (!(truth.depth.ptr<float>()[i] > 0)) continue;
+    if (label[i] == 0 || label[i] == 1 || (label[i] == 9 && in_front(i))) glued.push_back(i);
+    else if (label[i] == 9) rest_of_floor.push_back(i);
+    else small_box.push_back(i);
+  }
+  const Eigen::Vector3f up = direction_up(scene);
+  std::vector<Patch> patches = {patch_with(1, glued, false, {}), patch_with(2, rest_of_floor, false, {}),
+                                patch_with(3, small_box, false, {})};
+  for (Patch& p : patches) p.mean_normal = up;  // what the table and the floor hold most of
+  ASSERT_GT(rest_of_floor.size(), glued.size());
+  const Eigen::Vector3f table_centre = (scene.world_to_camera * Eigen::Vector3d::Zero()).cast<float>();
+
+  // Off: the glued patch is no plane, so the floor is the support.
+  Params::Support off;
+  off.glued_share = 0;
+  const std::optional<Plane> floor_plane = find_support_plane(patches, points, scene.camera, off);
+  ASSERT_TRUE(floor_plane);
+  EXPECT_NEAR(floor_plane->distance(table_centre), 0.3f, 0.01f);
+
+  // On (the default): the table, fitted on its own points, and the box and the floor cut from it.
+  const Params::Support on;
+  const std::optional<Plane> plane = find_support_plane(patches, points, scene.camera, on);
+  ASSERT_TRUE(plane);
+  EXPECT_LT(std::abs(plane->distance(table_centre)), 0.003f);
+  EXPECT_GT(plane->normal.dot(up), 0.999f);
+  cv::Mat patch_labels(truth.depth.size(), CV_32S, cv::Scalar(0)), edges(truth.depth.size(), CV_8U, cv::Scalar(255));
+  for (const Patch& p : patches)
+    for (int i : p.pixels) patch_labels.ptr<int>()[i] = p.id, edges.ptr<uchar>()[i] = 0;
+  ASSERT_GT(cut_off_table(edges, patches, patch_labels, points, *plane, on, 50), 0);
+  cv::Mat parts;  // of the glued patch
+  cv::connectedComponents((edges == 0) & (patch_labels == 1), parts, 4);
+  std::set<int> table_parts;
+  for (int i : glued)
+    if (label[i] == 0) table_parts.insert(parts.ptr<int>()[i]);
+  table_parts.erase(0);  // the cut pixels
+  // Every pixel of the box or the floor clear of the table's plane is cut off the table (the box's foot,
+  // within the plane's tolerance, stays with it).
+  int box_clear = 0, floor_clear = 0;
+  for (int i : glued) {
+    const cv::Vec3f q = points.ptr<cv::Vec3f>()[i];
+    if (label[i] == 0 || std::abs(plane->distance({q[0], q[1], q[2]})) <= plane_tolerance(on.plane_band, q[2])) continue;
+    (label[i] == 1 ? box_clear : floor_clear)++;
+    EXPECT_FALSE(table_parts.count(parts.ptr<int>()[i])) << "pixel " << i << " of " << label[i] << " is still one patch with the table";
+  }
+  EXPECT_GT(box_clear, 2000);
+  EXPECT_GT(floor_clear, 2000);
+}
+
 TEST(Support, APatchOfTwoParallelTopsIsSplitAtItsPlane) {
   // A box and a smaller one beside it, their tops 2 cm apart in height; one patch holding both tops, as
   // if the edges had a gap between them.

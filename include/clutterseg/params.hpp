@@ -195,6 +195,12 @@ struct Params {
                                     // within contact_distance) and at least this share of its outline hides
                                     // a surface 10 % farther: a laptop's lid (walls are the farthest
                                     // surface) [-]; 0 = off
+    double glued_share = 0.35;     // beyond the paper: a large patch with this share of its points on one
+                                   // plane (not only 60 %) is a table candidate, a table patch needs this
+                                   // share within the plane's tolerance (not half) to be cut at the plane,
+                                   // and is cut below it as well as above: depth smoothed so much (filtered
+                                   // stereo) that objects and the floor past the table's edge have no edge
+                                   // band around them is one patch with the table [-]; 0 = off
     double enclosed_share = 0.8;   // beyond the paper: a table piece whose surroundings are at least this
                                    // share one object's (after stage j) is that object's floor, as in a pan
                                    // with a thin rim (claim_enclosed_floors) [-]; 0 = off

@@ -67,7 +67,8 @@ bool fit_plane(const std::vector<int>& pixels, const cv::Mat& points, Plane& pla
 bool mostly_within(const std::vector<int>& pixels, const cv::Mat& points, const Plane& plane, double band,
                    double share);
 
-// The support plane: among the large patches that are planar (RANSAC), the one with the most pixels of
+// The support plane: among the large patches that are planar (RANSAC: 60 % of the points on one plane, or
+// glued_share of them when that is on), the one with the most pixels of
 // other patches resting on its camera-facing side (reaching down to within contact_distance of it, at most
 // max_height above it, over its visible region); then
 // refitted over every patch lying in it, twice (a table split into pieces by the objects on it is one
@@ -90,11 +91,13 @@ bool lies_in(const Patch& patch, const cv::Mat& points, const Plane& plane, cons
 // Unmarks such patches; returns how many. A ratio of 0 unmarks nothing.
 int unmark_curved_table(std::vector<Patch>& patches, const Params::Support& params);
 
-// Patches that are mostly table but hold core pixels standing clear of the plane (more than the plane
-// tolerance above it): objects the edges did not close off (a gap in the edge band, a smooth foot). Marks
+// Patches that are mostly table (half their points within the plane's tolerance, glued_share when that
+// is on) but hold core pixels standing clear of the plane (more than the plane tolerance above it; or
+// below it, when glued_share is on: the floor seen past the table's edge): objects the edges did not close
+// off (a gap in the edge band, a smooth foot, depth smoothed so much that no edge is left). Marks
 // in `edges` (CV_8U, 255 = edge) the pixels where such a part meets the table part of its patch, so that
 // extracting the patches again separates them. Returns the number of pixels cut off (0: edges unchanged);
-// parts smaller than min_px are left to the table.
+// patches with fewer than min_px such pixels are left whole.
 int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::Mat& patch_labels, const cv::Mat& points,
                   const Plane& plane, const Params::Support& params, int min_px);
 
