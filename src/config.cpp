@@ -22,7 +22,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Convexity, enabled, tole
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Coplanarity, enabled, angle_deg, triples, lines, behind_fraction, behind_tolerance, lines_pass, max_gap,
                                                 planar_share, planar_band, front_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Curvature, enabled, theta_h, open_objects, occluded, line_fit, neighbour_gap_px, concentric,
-                                                open_centre)
+                                                open_centre, split_inside)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::GraphCut, theta_c)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Remaining, grow_distance, gap_px, tiny_px, min_contact_share, hole_px, shadow_baseline, occluded_jump,
                                                 hidden_coplanar_band)

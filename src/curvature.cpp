@@ -244,6 +244,15 @@ bool concentric(const CurvatureCentre& outer, const CurvatureCentre& inner, doub
   return d <= share * outer.radius;
 }
 
+// Two parts of one surface: both centres a point (a sphere) or both an axis (a cylinder), each on the other
+// within `share` of the larger radius, and the radii within that share of each other.
+bool one_surface(const CurvatureCentre& a, const CurvatureCentre& b, double share) {
+  if (!a.valid || !b.valid || a.axis.isZero() != b.axis.isZero()) return false;
+  const double r = std::max(a.radius, b.radius);
+  return std::min(a.radius, b.radius) >= (1 - share) * r && a.distance(b.point) <= share * r &&
+         b.distance(a.point) <= share * r;
+}
+
 }  // namespace
 
 double histogram_similarity(const std::vector<float>& a, const std::vector<float>& b) {
@@ -323,8 +332,8 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
     if (patches[i].curved && !patches[i].pixels.empty()) curved.push_back(static_cast<int>(i));
 
   // Similar histograms first (121 bins per pair); the pixel work only for the similar pairs and, for the
-  // concentric-walls rule, the others.
-  std::vector<PatchPair> similar, walls;
+  // concentric-walls rule, the others. Every pair is a candidate for the split-inside rule.
+  std::vector<PatchPair> similar, walls, insides;
   for (size_t x = 0; x < curved.size(); ++x)
     for (size_t y = x + 1; y < curved.size(); ++y) {
       const int i = curved[x], j = curved[y];
@@ -332,10 +341,11 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
       const auto& a = patches[static_cast<size_t>(i)];
       const auto& b = patches[static_cast<size_t>(j)];
       if (a.histogram.size() != b.histogram.size() || a.histogram.empty()) continue;
+      if (p.open_objects && p.split_inside > 0) insides.emplace_back(i, j);
       if (histogram_similarity(a.histogram, b.histogram) > p.theta_h) similar.emplace_back(i, j);
       else if (p.open_objects && p.concentric > 0) walls.emplace_back(i, j);
     }
-  if (similar.empty() && walls.empty()) return out;
+  if (similar.empty() && walls.empty() && insides.empty()) return out;
 
   const PixelScale px(camera.fx, camera.fy);
   const int gap = px.length(p.neighbour_gap_px);
@@ -424,6 +434,14 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   }
   for (const auto& [i, j] : walls)
     if (neighbours(i, j)) out.push_back({{i, j}, Cue::CurvatureOpen});
+  // The inside of one open object that something standing in it or in front of it splits (a can in a bowl):
+  // two concave patches on one sphere or cylinder (beyond the paper). Their histograms differ (the two
+  // halves face each other), and they need not be image neighbours.
+  for (const auto& [i, j] : insides) {
+    if (convexity_of(i) != -1 || convexity_of(j) != -1 || !one_surface(centre_of(i), centre_of(j), p.split_inside)) continue;
+    if (std::none_of(out.begin(), out.end(), [&](const CurvatureLink& l) { return l.pair == PatchPair(i, j); }))
+      out.push_back({{i, j}, Cue::CurvatureOccluded});
+  }
   return out;
 }
 

@@ -82,6 +82,7 @@ void validate(const Params& p) {
   in_range("curvature.neighbour_gap_px", p.curvature.neighbour_gap_px, 0, 50);
   in_range("curvature.concentric", p.curvature.concentric, 0, 1);
   in_range("curvature.open_centre", p.curvature.open_centre, 0, 10);
+  in_range("curvature.split_inside", p.curvature.split_inside, 0, 1);
   in_range("graph.theta_c", p.graph.theta_c, 0, 1000);
   in_range("remaining.grow_distance", p.remaining.grow_distance, 0, 1);
   in_range("remaining.gap_px", p.remaining.gap_px, 0, 16);

@@ -251,3 +251,56 @@ TEST(Curvature, OpenObjectRuleAsksTheWallsForOneAxis) {
   EXPECT_TRUE(links_for(0.15f, Params{}).empty());  // the inside's axis 3 radii from the outside's
   ASSERT_EQ(links_for(0.15f, off).size(), 1u);      // the paper's rule alone links them
 }
+
+// Beyond the paper (curvature.split_inside): a bowl's inside split by a can standing in it (tabletop-realsense
+// 000003) is two concave patches that face each other, so their histograms differ, and the can lies between
+// them in the image. Two hand-made parts of the inside of a sphere of radius 8 cm, 30 px apart: linked when
+// they lie on one sphere; not when the right part's sphere is 3 radii away (two bowls), nor with the rule off.
+TEST(Curvature, TheTwoSidesOfABowlsInsideSplitByACanAreLinked) {
+  const int h = 30, w = 40, gap = 30, cols = 2 * w + gap;
+  Camera camera;
+  camera.fx = camera.fy = 525;
+  camera.cx = cols / 2.0;
+  camera.cy = h / 2.0;
+  camera.width = cols;
+  camera.height = h;
+  const auto links_for = [&](float right_offset, const Params& params) {
+    cv::Mat points(h, cols, CV_32FC3, cv::Scalar::all(0)), labels(h, cols, CV_32S, cv::Scalar(0));
+    NormalPlanes normals{cv::Mat(h, cols, CV_32F, cv::Scalar(0)), cv::Mat(h, cols, CV_32F, cv::Scalar(0)),
+                         cv::Mat(h, cols, CV_32F, cv::Scalar(0))};
+    std::vector<Patch> patches(2);
+    const float r = 0.08f, z0 = 1.f;
+    for (int k = 0; k < 2; ++k) {
+      const int first = k == 0 ? 0 : w + gap;
+      const float centre_x = k == 0 ? 0.f : right_offset, from = k == 0 ? -50.f : 10.f;  // azimuth [deg]
+      Patch& p = patches[static_cast<size_t>(k)];
+      p.id = k + 1;
+      p.curved = true;
+      p.bbox = cv::Rect(first, 0, w, h);
+      p.histogram.assign(121, 0.f);
+      for (int b = 0; b < 11; ++b) p.histogram[static_cast<size_t>(11 * b + (k == 0 ? 2 : 8))] = 1.f / 11;  // apart
+      for (int v = 0; v < h; ++v)
+        for (int u = 0; u < w; ++u) {
+          const float ax = (from + 40.f * static_cast<float>(u) / (w - 1)) * static_cast<float>(M_PI / 180);
+          const float ay = (-20.f + 40.f * static_cast<float>(v) / (h - 1)) * static_cast<float>(M_PI / 180);
+          const Eigen::Vector3f d(std::sin(ax) * std::cos(ay), std::sin(ay), std::cos(ax) * std::cos(ay));
+          const Eigen::Vector3f q = Eigen::Vector3f(centre_x, 0, z0) + r * d;  // the far side: seen from inside
+          const int x = first + u;
+          points.at<cv::Vec3f>(v, x) = {q.x(), q.y(), q.z()};
+          for (int c = 0; c < 3; ++c) normals[static_cast<size_t>(c)].at<float>(v, x) = -d(c);  // towards the centre
+          labels.at<int>(v, x) = p.id;
+          p.pixels.push_back(v * cols + x);
+        }
+    }
+    for (const Patch& p : patches) EXPECT_EQ(convexity(p, points, normals, 11), -1);
+    EXPECT_LT(histogram_similarity(patches[0].histogram, patches[1].histogram), params.curvature.theta_h);
+    return curvature_links(patches, {}, labels, points, normals, camera, params);
+  };
+  const auto one_bowl = links_for(0.f, Params{});
+  ASSERT_EQ(one_bowl.size(), 1u);
+  EXPECT_EQ(one_bowl[0].pair, PatchPair(0, 1));
+  EXPECT_TRUE(links_for(0.24f, Params{}).empty());  // two bowls side by side
+  Params off;
+  off.curvature.split_inside = 0;
+  EXPECT_TRUE(links_for(0.f, off).empty());
+}

@@ -23,7 +23,9 @@ struct CurvatureLink {
 // (open object; the centre test is beyond the paper), or a 3D line through both patches' peak-bin
 // points that fits within line_fit and passes the occlusion check (occluded curved object). Beyond the
 // paper, image neighbours of opposite convexity whatever their histograms whose normals meet at one
-// centre or axis (params.curvature.concentric; an open object's outer wall and its inside).
+// centre or axis (params.curvature.concentric; an open object's outer wall and its inside), and concave
+// patches, image neighbours or not, on one sphere or cylinder (params.curvature.split_inside; an open
+// object's inside split by something standing in it).
 std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches,
                                            const std::vector<PatchPair>& linked,
                                            const cv::Mat& assigned_labels, const cv::Mat& points,
