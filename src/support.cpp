@@ -24,6 +24,10 @@ Eigen::Vector3f point_at(const cv::Vec3f* pts, int i) { return {pts[i][0], pts[i
 // Params::Support::glued_share is on: a table with objects glued to it is found and cut (beyond the paper).
 bool glued(const Params::Support& params) { return params.glued_share > 0; }
 
+// The share of a table patch's points that must lie within the plane's tolerance for the refit to keep it and
+// for cut_off_table to cut it: half, or glued_share when that is on and lower.
+double table_share(const Params::Support& params) { return glued(params) ? std::min(0.5, params.glued_share) : 0.5; }
+
 // Largest a * x + b * y over the points, a and b in {-1, 0, 1} (exact: no rounding but the one sum).
 CLUTTERSEG_ROW_KERNEL float largest_projection(const float* __restrict x, const float* __restrict y, int n, float a,
                                                float b) {
@@ -445,7 +449,6 @@ std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const
   // tolerance are part of every refit, and it must keep glued_share of them.
   const int seed_index = candidates[static_cast<size_t>(best)];
   const Patch& seed = patches[static_cast<size_t>(seed_index)];
-  const double seed_share = glued(params) ? std::min(0.5, params.glued_share) : 0.5;
   Plane plane = planes[static_cast<size_t>(best)];
   for (int pass = 0; pass < 2; ++pass) {
     std::vector<int> near = patches_near(patches, points, plane, params);
@@ -453,7 +456,7 @@ std::optional<Plane> find_support_plane(const std::vector<Patch>& patches, const
       near.insert(std::lower_bound(near.begin(), near.end(), seed_index), seed_index);
     Plane refitted = plane;
     if (near.empty() || !refit(patches, near, points, params.plane_band, refitted) ||
-        !is_near(seed, points, refitted, params, seed_share))
+        !is_near(seed, points, refitted, params, table_share(params)))
       break;
     plane = refitted;
   }
@@ -554,8 +557,7 @@ int cut_off_table(cv::Mat& edges, const std::vector<Patch>& patches, const cv::M
   };
   cv::Mat clear;  // core pixels of table patches clear of the plane
   int cut = 0;
-  const double share = glued(params) ? std::min(0.5, params.glued_share) : 0.5;  // of points in the plane
-  for (const int p : patches_near(patches, points, plane, params, share)) {
+  for (const int p : patches_near(patches, points, plane, params, table_share(params))) {
     const auto& pixels = patches[static_cast<size_t>(p)].pixels;
     const int count = clear_of(pixels, nullptr);
     if (count < min_px) continue;
