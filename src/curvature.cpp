@@ -437,10 +437,11 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   // The inside of one open object that something standing in it or in front of it splits (a can in a bowl):
   // two concave patches on one sphere or cylinder (beyond the paper). Their histograms differ (the two
   // halves face each other), and they need not be image neighbours.
-  for (const auto& [i, j] : insides) {
+  for (const PatchPair& pair : insides) {
+    const auto [i, j] = pair;
     if (convexity_of(i) != -1 || convexity_of(j) != -1 || !one_surface(centre_of(i), centre_of(j), p.split_inside)) continue;
-    if (std::none_of(out.begin(), out.end(), [&](const CurvatureLink& l) { return l.pair == PatchPair(i, j); }))
-      out.push_back({{i, j}, Cue::CurvatureOccluded});
+    if (std::none_of(out.begin(), out.end(), [&](const CurvatureLink& l) { return l.pair == pair; }))
+      out.push_back({pair, Cue::CurvatureOccluded});
   }
   return out;
 }
