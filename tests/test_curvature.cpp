@@ -42,6 +42,33 @@ Synthetic cylinder_patch(int side) {
   return s;
 }
 
+// An empty h x cols frame for hand-made patches side by side (a camera at the origin looking along +z), and
+// a pixel of a patch put into it with its point and normal.
+struct HandMadeFrame {
+  Camera camera;
+  cv::Mat points, labels;
+  NormalPlanes normals;
+  HandMadeFrame(int h, int cols)
+      : points(h, cols, CV_32FC3, cv::Scalar::all(0)), labels(h, cols, CV_32S, cv::Scalar(0)),
+        normals{cv::Mat(h, cols, CV_32F, cv::Scalar(0)), cv::Mat(h, cols, CV_32F, cv::Scalar(0)),
+                cv::Mat(h, cols, CV_32F, cv::Scalar(0))} {
+    camera.fx = camera.fy = 525;
+    camera.cx = cols / 2.0;
+    camera.cy = h / 2.0;
+    camera.width = cols;
+    camera.height = h;
+  }
+  void put(Patch& p, int v, int x, const Eigen::Vector3f& q, const Eigen::Vector3f& n) {
+    points.at<cv::Vec3f>(v, x) = {q.x(), q.y(), q.z()};
+    for (int d = 0; d < 3; ++d) normals[static_cast<size_t>(d)].at<float>(v, x) = n(d);
+    labels.at<int>(v, x) = p.id;
+    p.pixels.push_back(v * points.cols + x);
+  }
+  std::vector<CurvatureLink> links(const std::vector<Patch>& patches, const Params& params) const {
+    return curvature_links(patches, {}, labels, points, normals, camera, params);
+  }
+};
+
 }  // namespace
 
 TEST(Histogram, SimilarityIsTheSharedMass) {
@@ -208,16 +235,8 @@ TEST(Curvature, ConcentricRuleLinksTheBowlWallsOnly) {
 // whose axis lies 3 radii away (complex-000017: two cans, one read as concave) only with the test off.
 TEST(Curvature, OpenObjectRuleAsksTheWallsForOneAxis) {
   const int h = 20, w = 60, gap = 5, cols = 2 * w + gap;
-  Camera camera;
-  camera.fx = camera.fy = 525;
-  camera.cx = cols / 2.0;
-  camera.cy = h / 2.0;
-  camera.width = cols;
-  camera.height = h;
   const auto links_for = [&](float axis_offset, const Params& params) {
-    cv::Mat points(h, cols, CV_32FC3, cv::Scalar::all(0)), labels(h, cols, CV_32S, cv::Scalar(0));
-    NormalPlanes normals{cv::Mat(h, cols, CV_32F, cv::Scalar(0)), cv::Mat(h, cols, CV_32F, cv::Scalar(0)),
-                         cv::Mat(h, cols, CV_32F, cv::Scalar(0))};
+    HandMadeFrame frame(h, cols);
     std::vector<Patch> patches(2);
     const float r = 0.05f, z0 = 1.f;
     for (int k = 0; k < 2; ++k) {
@@ -232,16 +251,12 @@ TEST(Curvature, OpenObjectRuleAsksTheWallsForOneAxis) {
       for (int v = 0; v < h; ++v)
         for (int u = 0; u < w; ++u) {
           const float a = (static_cast<float>(u) / (w - 1) - 0.5f) * static_cast<float>(M_PI / 3);
-          const int x = first + u;
-          points.at<cv::Vec3f>(v, x) = {axis_x + r * std::sin(a), 0.002f * static_cast<float>(v),
-                                         z0 - static_cast<float>(side) * r * std::cos(a)};
-          const Eigen::Vector3f n(static_cast<float>(side) * std::sin(a), 0, -std::cos(a));
-          for (int d = 0; d < 3; ++d) normals[static_cast<size_t>(d)].at<float>(v, x) = n(d);
-          labels.at<int>(v, x) = p.id;
-          p.pixels.push_back(v * cols + x);
+          frame.put(p, v, first + u,
+                    {axis_x + r * std::sin(a), 0.002f * static_cast<float>(v), z0 - static_cast<float>(side) * r * std::cos(a)},
+                    {static_cast<float>(side) * std::sin(a), 0, -std::cos(a)});
         }
     }
-    return curvature_links(patches, {}, labels, points, normals, camera, params);
+    return frame.links(patches, params);
   };
   Params off;
   off.curvature.open_centre = 0;
@@ -258,16 +273,8 @@ TEST(Curvature, OpenObjectRuleAsksTheWallsForOneAxis) {
 // they lie on one sphere; not when the right part's sphere is 3 radii away (two bowls), nor with the rule off.
 TEST(Curvature, TheTwoSidesOfABowlsInsideSplitByACanAreLinked) {
   const int h = 30, w = 40, gap = 30, cols = 2 * w + gap;
-  Camera camera;
-  camera.fx = camera.fy = 525;
-  camera.cx = cols / 2.0;
-  camera.cy = h / 2.0;
-  camera.width = cols;
-  camera.height = h;
   const auto links_for = [&](float right_offset, const Params& params) {
-    cv::Mat points(h, cols, CV_32FC3, cv::Scalar::all(0)), labels(h, cols, CV_32S, cv::Scalar(0));
-    NormalPlanes normals{cv::Mat(h, cols, CV_32F, cv::Scalar(0)), cv::Mat(h, cols, CV_32F, cv::Scalar(0)),
-                         cv::Mat(h, cols, CV_32F, cv::Scalar(0))};
+    HandMadeFrame frame(h, cols);
     std::vector<Patch> patches(2);
     const float r = 0.08f, z0 = 1.f;
     for (int k = 0; k < 2; ++k) {
@@ -284,17 +291,13 @@ TEST(Curvature, TheTwoSidesOfABowlsInsideSplitByACanAreLinked) {
           const float ax = (from + 40.f * static_cast<float>(u) / (w - 1)) * static_cast<float>(M_PI / 180);
           const float ay = (-20.f + 40.f * static_cast<float>(v) / (h - 1)) * static_cast<float>(M_PI / 180);
           const Eigen::Vector3f d(std::sin(ax) * std::cos(ay), std::sin(ay), std::cos(ax) * std::cos(ay));
-          const Eigen::Vector3f q = Eigen::Vector3f(centre_x, 0, z0) + r * d;  // the far side: seen from inside
-          const int x = first + u;
-          points.at<cv::Vec3f>(v, x) = {q.x(), q.y(), q.z()};
-          for (int c = 0; c < 3; ++c) normals[static_cast<size_t>(c)].at<float>(v, x) = -d(c);  // towards the centre
-          labels.at<int>(v, x) = p.id;
-          p.pixels.push_back(v * cols + x);
+          // The far side, seen from inside; normals towards the centre.
+          frame.put(p, v, first + u, Eigen::Vector3f(centre_x, 0, z0) + r * d, -d);
         }
     }
-    for (const Patch& p : patches) EXPECT_EQ(convexity(p, points, normals, 11), -1);
+    for (const Patch& p : patches) EXPECT_EQ(convexity(p, frame.points, frame.normals, 11), -1);
     EXPECT_LT(histogram_similarity(patches[0].histogram, patches[1].histogram), params.curvature.theta_h);
-    return curvature_links(patches, {}, labels, points, normals, camera, params);
+    return frame.links(patches, params);
   };
   const auto one_bowl = links_for(0.f, Params{});
   ASSERT_EQ(one_bowl.size(), 1u);
