@@ -244,8 +244,8 @@ bool refit(const std::vector<Patch>& patches, const std::vector<int>& table, con
   return fit.plane(plane);
 }
 
-// A patch a plane's refit is made from: normal close to the plane's, half of the points within the
-// tolerance (a patch that holds an object's foot still counts).
+// A patch a plane's refit is made from: normal close to the plane's, `share` of the points (half unless
+// told) within the tolerance (a patch that holds an object's foot still counts).
 bool is_near(const Patch& patch, const cv::Mat& points, const Plane& plane, const Params::Support& params,
              double share = 0.5) {
   const float min_cos = static_cast<float>(std::cos(params.table_angle_deg * M_PI / 180.0));
