@@ -79,4 +79,57 @@ std::vector<PairJunction> classify_junctions(const std::vector<Contact>& contact
   return out;
 }
 
+std::vector<PatchPair> contacts_across_tops(const std::vector<PairJunction>& junctions, std::span<const Patch> patches,
+                                            const cv::Mat& points, const Eigen::Vector3f& up,
+                                            const Params::Convexity& params) {
+  std::vector<PatchPair> out;
+  if (params.top_angle_deg <= 0 || points.type() != CV_32FC3) return out;
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const float top_cos = static_cast<float>(std::cos(params.top_angle_deg * M_PI / 180.0));
+  const auto kind_of = [&](int a, int b) -> const PairJunction* {
+    const PatchPair pair(std::min(a, b), std::max(a, b));
+    const auto j = std::lower_bound(junctions.begin(), junctions.end(), pair,
+                                    [](const PairJunction& x, const PatchPair& p) { return x.pair < p; });
+    return j != junctions.end() && j->pair == pair ? &*j : nullptr;
+  };
+  // Whether `side` (+1 above, -1 below) holds 90 % of a patch's points, the plane through the top face's
+  // centroid along its mean normal (a noisy top's normals need not fit a plane).
+  const auto on_side = [&](const Patch& patch, const Patch& top, int side) {
+    constexpr size_t kSamples = 200;
+    constexpr double kTolerance = 0.005, kShare = 0.9;
+    const size_t stride = std::max<size_t>(1, patch.pixels.size() / kSamples);
+    int on = 0, all = 0;
+    for (size_t k = 0; k < patch.pixels.size(); k += stride) {
+      const cv::Vec3f& q = pts[patch.pixels[k]];
+      if (!valid_point(q)) continue;
+      const float height = top.mean_normal.dot(Eigen::Vector3f(q[0], q[1], q[2]) - top.centroid);
+      const double z = q[2];
+      ++all;
+      on += side * height > -kTolerance * std::max(1.0, z * z);
+    }
+    return all > 0 && on >= kShare * all;
+  };
+  const int n = static_cast<int>(patches.size());
+  for (const PairJunction& resting : junctions) {
+    if (resting.kind != Junction::Concave) continue;
+    for (const auto& [a, b] : {resting.pair, PatchPair(resting.pair.second, resting.pair.first)}) {  // a rests on b
+      if (a < 0 || b < 0 || a >= n || b >= n) continue;
+      const Patch& top = patches[static_cast<size_t>(b)];
+      // The top face's normal faces the camera; "up" may point either way along the table's normal.
+      if (std::abs(top.mean_normal.dot(up)) < top_cos || !on_side(patches[static_cast<size_t>(a)], top, +1)) continue;
+      for (const PairJunction& edge : junctions) {  // b's side faces: convex edges, below b's plane
+        if (edge.kind != Junction::Convex || (edge.pair.first != b && edge.pair.second != b)) continue;
+        const int c = edge.pair.first == b ? edge.pair.second : edge.pair.first;
+        if (c == a || c < 0 || c >= n) continue;
+        const PairJunction* touching = kind_of(a, c);
+        if (!touching || touching->kind == Junction::Concave || touching->kind == Junction::Step) continue;
+        if (on_side(patches[static_cast<size_t>(c)], top, -1)) out.emplace_back(std::min(a, c), std::max(a, c));
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 }  // namespace clutterseg

@@ -446,4 +446,33 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   return out;
 }
 
+std::vector<PatchPair> creases_inside(const std::vector<Patch>& patches, const std::vector<PatchPair>& pairs,
+                                      const cv::Mat& points, const NormalPlanes& normals, double share) {
+  std::vector<PatchPair> out;
+  if (share <= 0) return out;
+  // Each patch's convexity and centre once (a patch meets several others; few pairs per frame are concave).
+  std::vector<int> convex(patches.size(), 2);  // 2 = not computed yet
+  std::vector<std::optional<CurvatureCentre>> centres(patches.size());
+  const auto concave = [&](int i) {
+    const Patch& patch = patches[static_cast<size_t>(i)];
+    int& c = convex[static_cast<size_t>(i)];
+    if (c == 2) c = convexity(patch, points, normals, histogram_side(patch.histogram));
+    return c == -1;
+  };
+  const auto centre_of = [&](int i) -> const CurvatureCentre& {
+    auto& c = centres[static_cast<size_t>(i)];
+    if (!c) c = curvature_centre(patches[static_cast<size_t>(i)], points, normals);
+    return *c;
+  };
+  // The centres first: on most creases (a box on a box, a can on a book) one side has none. Creases with the
+  // table are no link of the graph.
+  const auto candidate = [&](int i) { return patches[static_cast<size_t>(i)].curved && !patches[static_cast<size_t>(i)].table; };
+  for (const PatchPair& pair : pairs) {
+    if (!candidate(pair.first) || !candidate(pair.second)) continue;
+    if (one_surface(centre_of(pair.first), centre_of(pair.second), share) && concave(pair.first) && concave(pair.second))
+      out.push_back(pair);
+  }
+  return out;
+}
+
 }  // namespace clutterseg

@@ -66,6 +66,7 @@ void validate(const Params& p) {
   in_range("convexity.tolerance", p.convexity.tolerance, 0, 2);
   in_range("convexity.step", p.convexity.step, 0, 1);
   in_range("convexity.concave_weight", p.convexity.concave_weight, 0, 1);
+  in_range("convexity.top_angle_deg", p.convexity.top_angle_deg, 0, 90);
   in_range("convexity.step_offset", p.convexity.step_offset, 0, 1);
   in_range("coplanarity.angle_deg", p.coplanarity.angle_deg, 0, 180);
   int_range("coplanarity.triples", p.coplanarity.triples, 1, 10000);

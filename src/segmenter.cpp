@@ -26,17 +26,30 @@ namespace clutterseg {
 
 namespace {
 
+// The adjacent pairs whose junction is a concave crease or a step.
+std::vector<PatchPair> concave_pairs(const std::vector<PairJunction>& junctions) {
+  std::vector<PatchPair> pairs;
+  for (const PairJunction& j : junctions)
+    if (j.kind == Junction::Concave || j.kind == Junction::Step) pairs.push_back(j.pair);
+  return pairs;
+}
+
 // The patch graph of paper i): every link with its cue, weighted 1/deg and symmetrised; adjacent pairs
-// that meet in a concave crease are weighted down (beyond the paper, Params::Convexity).
+// that meet in a concave crease or a step are weighted down (beyond the paper, Params::Convexity), and so
+// are the `across` pairs (an object on a top face touching a face below its edge), but not the creases
+// inside one open object (`inside`); both sorted.
 std::vector<GraphEdge> patch_graph(const std::vector<Patch>& patches, const std::vector<PatchPair>& adjacent,
-                                   const std::vector<PairJunction>& junctions, const std::vector<PatchPair>& coplanar,
+                                   const std::vector<PairJunction>& junctions, const std::vector<PatchPair>& across,
+                                   const std::vector<PatchPair>& inside, const std::vector<PatchPair>& coplanar,
                                    const std::vector<CurvatureLink>& curved, const Params::Convexity& convexity) {
   std::vector<GraphEdge> links;
   for (const auto& [a, b] : adjacent) {
     const auto j = std::lower_bound(junctions.begin(), junctions.end(), PatchPair(a, b),
                                     [](const PairJunction& x, const PatchPair& p) { return x.pair < p; });
-    const bool concave = j != junctions.end() && j->pair == PatchPair(a, b) &&
-                         (j->kind == Junction::Concave || j->kind == Junction::Step);
+    const bool crease = j != junctions.end() && j->pair == PatchPair(a, b) &&
+                        (j->kind == Junction::Concave || j->kind == Junction::Step);
+    const bool concave = (crease || std::binary_search(across.begin(), across.end(), PatchPair(a, b))) &&
+                         !std::binary_search(inside.begin(), inside.end(), PatchPair(a, b));
     links.push_back({a, b, concave ? Cue::AdjacentConcave : Cue::Adjacent, 0,
                      j != junctions.end() && j->pair == PatchPair(a, b) ? j->convexity : std::numeric_limits<float>::quiet_NaN()});
   }
@@ -155,6 +168,12 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   const int num_patches = static_cast<int>(r.patches.size());
   const std::vector<PairJunction> junctions = p.convexity.enabled                         // convex or concave
       ? classify_junctions(assignment.contacts, r.points, r.normals, p.convexity, r.patches) : std::vector<PairJunction>{};
+  const std::vector<PatchPair> across = p.convexity.enabled                              // a can flush with
+      ? contacts_across_tops(junctions, r.patches, r.points, table ? table->normal : up_in_camera(camera), p.convexity)
+      : std::vector<PatchPair>{};                                                        // a box's front
+  const std::vector<PatchPair> inside = p.curvature.enabled && p.curvature.inside_crease  // a bowl's wall into
+      ? creases_inside(r.patches, concave_pairs(junctions), r.points, r.normals, p.curvature.split_inside)  // its floor
+      : std::vector<PatchPair>{};
   watch.mark("convexity");
   std::vector<PatchPair> linked = links;
   const std::vector<PatchPair> coplanar = p.coplanarity.enabled                         // f/g) co-planarity
@@ -165,7 +184,7 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   const std::vector<CurvatureLink> curved = p.curvature.enabled                          // h) curvature
       ? curvature_links(r.patches, linked, r.patch_labels, r.points, r.normals, camera, p) : std::vector<CurvatureLink>{};
   watch.mark("curvature");
-  r.graph = patch_graph(r.patches, links, junctions, coplanar, curved, p.convexity);                           // i) graph cut
+  r.graph = patch_graph(r.patches, links, junctions, across, inside, coplanar, curved, p.convexity);  // i) graph cut
   Partition parts = cut_graph(num_patches, r.graph, p.graph.theta_c);
   if (table) settle_table(r.patches, assignment.adjacent, parts.object_of_node, parts.cut_cost);  // one table
   watch.mark("graph_cut");

@@ -104,3 +104,61 @@ TEST(Contact, ClassifiesBuiltContacts) {
   std::vector<Contact> five(5, {0, 1, 0, 1});
   EXPECT_EQ(classify_junctions(five, points, NormalPlanes{nx, ny, nz}, Params::Convexity{})[0].kind, Junction::Convex);
 }
+
+
+// Beyond the paper (convexity.top_angle_deg): a can standing flush with the front of a box (tabletop-realsense
+// 000002, a can on a tin) touches the box's front with no crease, since the can's side runs on into it; only
+// the can's crease with the box's top tells a contact. Hand-made patches in the camera frame (up = -y): A above
+// the top B's plane, meeting B in a concave crease; C below it, meeting B in a convex edge; A touches C flat.
+TEST(Contact, AnObjectOnATopTouchesTheFacesBelowItsEdgeAsAContact) {
+  const int rows = 30, cols = 30;
+  const auto make = [&](float c_from, float c_to, const Eigen::Vector3f& top_normal) {
+    struct Scene {
+      cv::Mat points;
+      std::vector<Patch> patches;
+    } scene{cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0)), std::vector<Patch>(3)};
+    const float y_from[3] = {0.02f, 0.1f, c_from}, y_to[3] = {0.09f, 0.1f, c_to};  // A, B (the top at y = 0.1), C
+    for (int k = 0; k < 3; ++k) {
+      Patch& patch = scene.patches[static_cast<size_t>(k)];
+      patch.id = k + 1;
+      for (int v = 10 * k; v < 10 * k + 10; ++v)
+        for (int u = 0; u < cols; ++u) {
+          const float t = static_cast<float>(v - 10 * k) / 9.f, x = 0.01f * static_cast<float>(u - cols / 2);
+          const cv::Vec3f q(x, y_from[k] + t * (y_to[k] - y_from[k]), k == 1 ? 1.f + 0.01f * static_cast<float>(v - 10) : 1.f);
+          scene.points.at<cv::Vec3f>(v, u) = q;
+          patch.pixels.push_back(v * cols + u);
+          patch.centroid += Eigen::Vector3f(q[0], q[1], q[2]);
+        }
+      patch.centroid /= static_cast<float>(patch.pixels.size());
+      patch.mean_normal = k == 1 ? top_normal : Eigen::Vector3f(0, 0, -1);
+    }
+    return scene;
+  };
+  const auto junction = [](int a, int b, Junction kind) {
+    PairJunction j;
+    j.pair = {a, b};
+    j.kind = kind;
+    j.samples = 10;
+    return j;
+  };
+  const std::vector<PairJunction> junctions = {junction(0, 1, Junction::Concave), junction(0, 2, Junction::Flat),
+                                               junction(1, 2, Junction::Convex)};
+  const Eigen::Vector3f up(0, -1, 0);
+  const Params::Convexity params;
+  const auto flush = make(0.11f, 0.2f, up);
+  EXPECT_EQ(contacts_across_tops(junctions, flush.patches, flush.points, up, params), std::vector<PatchPair>{PatchPair(0, 2)});
+  EXPECT_EQ(contacts_across_tops(junctions, flush.patches, flush.points, -up, params).size(), 1u);  // either sign of up
+  Params::Convexity off;
+  off.top_angle_deg = 0;
+  EXPECT_TRUE(contacts_across_tops(junctions, flush.patches, flush.points, up, off).empty());
+  const auto wall = make(0.11f, 0.2f, Eigen::Vector3f(1, 0, 0));  // B faces sideways: no top
+  EXPECT_TRUE(contacts_across_tops(junctions, wall.patches, wall.points, up, params).empty());
+  const auto above = make(0.02f, 0.09f, up);  // C above B's plane as well: no face below the top's edge
+  EXPECT_TRUE(contacts_across_tops(junctions, above.patches, above.points, up, params).empty());
+  const std::vector<PairJunction> creased = {junction(0, 1, Junction::Concave), junction(0, 2, Junction::Concave),
+                                             junction(1, 2, Junction::Convex)};  // already weighed down
+  EXPECT_TRUE(contacts_across_tops(creased, flush.patches, flush.points, up, params).empty());
+  const std::vector<PairJunction> convex_top = {junction(0, 1, Junction::Convex), junction(0, 2, Junction::Flat),
+                                                junction(1, 2, Junction::Convex)};  // A is B's own face
+  EXPECT_TRUE(contacts_across_tops(convex_top, flush.patches, flush.points, up, params).empty());
+}

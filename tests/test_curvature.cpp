@@ -267,15 +267,14 @@ TEST(Curvature, OpenObjectRuleAsksTheWallsForOneAxis) {
   ASSERT_EQ(links_for(0.15f, off).size(), 1u);      // the paper's rule alone links them
 }
 
-// Beyond the paper (curvature.split_inside): a bowl's inside split by a can standing in it (tabletop-realsense
-// 000003) is two concave patches that face each other, so their histograms differ, and the can lies between
-// them in the image. Two hand-made parts of the inside of a sphere of radius 8 cm, 30 px apart: linked when
-// they lie on one sphere; not when the right part's sphere is 3 radii away (two bowls), nor with the rule off.
-TEST(Curvature, TheTwoSidesOfABowlsInsideSplitByACanAreLinked) {
-  const int h = 30, w = 40, gap = 30, cols = 2 * w + gap;
-  const auto links_for = [&](float right_offset, const Params& params) {
-    HandMadeFrame frame(h, cols);
-    std::vector<Patch> patches(2);
+// Two hand-made parts of the inside of a sphere of radius 8 cm, 30 px apart in the image, the far side seen
+// from inside (normals towards the centre): the left part's sphere at the origin's x, the right part's
+// `right_offset` along x. Histograms apart (the two halves face each other).
+struct InsideParts {
+  HandMadeFrame frame{30, 110};
+  std::vector<Patch> patches = std::vector<Patch>(2);
+  explicit InsideParts(float right_offset) {
+    const int h = 30, w = 40, gap = 30;
     const float r = 0.08f, z0 = 1.f;
     for (int k = 0; k < 2; ++k) {
       const int first = k == 0 ? 0 : w + gap;
@@ -285,19 +284,28 @@ TEST(Curvature, TheTwoSidesOfABowlsInsideSplitByACanAreLinked) {
       p.curved = true;
       p.bbox = cv::Rect(first, 0, w, h);
       p.histogram.assign(121, 0.f);
-      for (int b = 0; b < 11; ++b) p.histogram[static_cast<size_t>(11 * b + (k == 0 ? 2 : 8))] = 1.f / 11;  // apart
+      for (int b = 0; b < 11; ++b) p.histogram[static_cast<size_t>(11 * b + (k == 0 ? 2 : 8))] = 1.f / 11;
       for (int v = 0; v < h; ++v)
         for (int u = 0; u < w; ++u) {
           const float ax = (from + 40.f * static_cast<float>(u) / (w - 1)) * static_cast<float>(M_PI / 180);
           const float ay = (-20.f + 40.f * static_cast<float>(v) / (h - 1)) * static_cast<float>(M_PI / 180);
           const Eigen::Vector3f d(std::sin(ax) * std::cos(ay), std::sin(ay), std::cos(ax) * std::cos(ay));
-          // The far side, seen from inside; normals towards the centre.
           frame.put(p, v, first + u, Eigen::Vector3f(centre_x, 0, z0) + r * d, -d);
         }
     }
-    for (const Patch& p : patches) EXPECT_EQ(convexity(p, frame.points, frame.normals, 11), -1);
-    EXPECT_LT(histogram_similarity(patches[0].histogram, patches[1].histogram), params.curvature.theta_h);
-    return frame.links(patches, params);
+  }
+};
+
+// Beyond the paper (curvature.split_inside): a bowl's inside split by a can standing in it (tabletop-realsense
+// 000003) is two concave patches that face each other, so their histograms differ, and the can lies between
+// them in the image: linked when they lie on one sphere; not when the right part's sphere is 3 radii away (two
+// bowls), nor with the rule off.
+TEST(Curvature, TheTwoSidesOfABowlsInsideSplitByACanAreLinked) {
+  const auto links_for = [&](float right_offset, const Params& params) {
+    const InsideParts parts(right_offset);
+    for (const Patch& p : parts.patches) EXPECT_EQ(convexity(p, parts.frame.points, parts.frame.normals, 11), -1);
+    EXPECT_LT(histogram_similarity(parts.patches[0].histogram, parts.patches[1].histogram), params.curvature.theta_h);
+    return parts.frame.links(parts.patches, params);
   };
   const auto one_bowl = links_for(0.f, Params{});
   ASSERT_EQ(one_bowl.size(), 1u);
@@ -306,4 +314,21 @@ TEST(Curvature, TheTwoSidesOfABowlsInsideSplitByACanAreLinked) {
   Params off;
   off.curvature.split_inside = 0;
   EXPECT_TRUE(links_for(0.f, off).empty());
+}
+
+// Beyond the paper (curvature.inside_crease): a bowl's wall turning into its floor meets it in a concave crease,
+// as a box meets the box it stands on; the two sides of that crease lying on one sphere tell the bowl
+// (tabletop-realsense 000001 and 000002). A crease between two concave parts of one sphere is inside; between
+// parts of two spheres 3 radii apart (two bowls touching), or a concave part and a plane, it is not.
+TEST(Curvature, ACreaseBetweenTwoPartsOfOneInsideIsNoContact) {
+  const double share = Params{}.curvature.split_inside;
+  const std::vector<PatchPair> crease = {{0, 1}};
+  const InsideParts one(0.f), two(0.24f);
+  EXPECT_EQ(creases_inside(one.patches, crease, one.frame.points, one.frame.normals, share), crease);
+  EXPECT_TRUE(creases_inside(two.patches, crease, two.frame.points, two.frame.normals, share).empty());
+  EXPECT_TRUE(creases_inside(one.patches, crease, one.frame.points, one.frame.normals, 0).empty());  // off
+  InsideParts flat(0.f);  // the right part a plane facing the camera: no centre, no convexity
+  for (const int i : flat.patches[1].pixels)
+    for (int d = 0; d < 3; ++d) flat.frame.normals[static_cast<size_t>(d)].at<float>(i / 110, i % 110) = d == 2 ? -1.f : 0.f;
+  EXPECT_TRUE(creases_inside(flat.patches, crease, flat.frame.points, flat.frame.normals, share).empty());
 }

@@ -39,4 +39,15 @@ std::vector<PairJunction> classify_junctions(const std::vector<Contact>& contact
                                              const NormalPlanes& normals, const Params::Convexity& params,
                                              std::span<const Patch> patches = {});
 
+// Beyond the paper (Params::Convexity::top_angle_deg): the links between an object resting on a top face and
+// the faces below that face's edge. A patch A meets a top face B (mean normal within top_angle_deg of `up`) in
+// a concave crease and lies above B's plane; a patch C meets B in a convex edge and lies below that plane (B's
+// side face). Where A also touches C (a can standing flush with the front of a box: the can's side runs on into
+// the box's front with no crease), that link is a contact between two objects as much as A-B is. Returns those
+// pairs (A, C), sorted, of the adjacent pairs in `junctions` that are not concave or a step already. A patch
+// lies above (below) a plane when 90 % of its points do, within 5 mm at 1 m depth (times z^2 beyond).
+std::vector<PatchPair> contacts_across_tops(const std::vector<PairJunction>& junctions, std::span<const Patch> patches,
+                                            const cv::Mat& points, const Eigen::Vector3f& up,
+                                            const Params::Convexity& params);
+
 }  // namespace clutterseg

@@ -32,4 +32,10 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches,
                                            const NormalPlanes& normals, const Camera& camera,
                                            const Params& params);
 
+// Of the adjacent `pairs` (a concave crease between each), those whose two patches are both concave and lie
+// on one sphere or cylinder within `share` (the split-inside test): a bowl's wall turning into its floor, one
+// surface, not two objects touching (beyond the paper, Params::Curvature::inside_crease).
+std::vector<PatchPair> creases_inside(const std::vector<Patch>& patches, const std::vector<PatchPair>& pairs,
+                                      const cv::Mat& points, const NormalPlanes& normals, double share);
+
 }  // namespace clutterseg

@@ -95,6 +95,10 @@ struct Params {
     double step_offset = 0.003;  // beyond: parallel faces (mean normals within 10 deg) offset along their
                                  // common normal by more than this across the contacts meet in a step,
                                  // whatever the contact normals say [m at 1 m, times z^2 beyond]; 0 = off
+    double top_angle_deg = 20;   // beyond: a face whose normal is within this of up is a top; a patch resting on
+                                 // it (concave crease, above its plane) touching a face below its edge (convex
+                                 // edge, below its plane) touches another object there: that link is weighed
+                                 // down too (a can flush with a box's front) [deg]; 0 = off
   } convexity;
 
   // f/g) Co-planarity of flat, non-adjacent patches separated by occlusion.
@@ -137,6 +141,10 @@ struct Params {
                                  // sphere's or both a cylinder's) lie on each other within this share of the
                                  // larger radius, radii within this share, are one open object's inside that
                                  // something standing in it splits (a can in a bowl) [-]; 0 = off
+    bool inside_crease = true;   // beyond the paper: a concave crease between two such patches (split_inside's
+                                 // test, image neighbours) is a bowl's wall turning into its floor, not a
+                                 // contact between objects: its link is not weighed down by
+                                 // convexity.concave_weight; false = every concave crease is (needs split_inside)
   } curvature;
 
   // i) Graph cut on the patch graph: w_ij = 1/deg(i), symmetrised.
