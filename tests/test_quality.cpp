@@ -173,6 +173,14 @@ TEST(Quality, ABowlsWallAndFloorAreOneObject) {
     const Result without = segment(depth, camera, off);
     EXPECT_NE(without.object_labels.at<int>(f.wall), without.object_labels.at<int>(f.floor)) << f.name;
   }
+  // 000002's teal bowl, a can standing in it: the two halves of its inside are one object, the can another
+  // (curvature.split_inside; the halves' centres lie 0.55 of the larger radius apart).
+  const Result r = segment(read_depth_png(set / "depth" / "000002.png"), camera);
+  const cv::Mat view = objects_only(r.object_labels, r.objects);
+  const cv::Point left(260, 210), right(360, 210), can(310, 215);
+  EXPECT_GT(view.at<int>(left), 0);
+  EXPECT_EQ(view.at<int>(left), view.at<int>(right));
+  EXPECT_NE(view.at<int>(left), view.at<int>(can));
 }
 
 // tabletop-realsense 000002 (no labels): a can stands on a tin, flush with the tin's front. The can's side and

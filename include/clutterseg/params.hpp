@@ -137,7 +137,7 @@ struct Params {
     double open_centre = 2.2;    // beyond the paper: the open-object rule's walls (similar histograms) must have
                                  // their centres of curvature within this share of the outer wall's radius, as
                                  // a cup's two walls do and two cylinders side by side do not [-]; 0 = off
-    double split_inside = 0.5;   // beyond the paper: two concave patches whose centres of curvature (both a
+    double split_inside = 0.6;   // beyond the paper: two concave patches whose centres of curvature (both a
                                  // sphere's or both a cylinder's) lie on each other within this share of the
                                  // larger radius, radii within this share, are one open object's inside that
                                  // something standing in it splits (a can in a bowl) [-]; 0 = off
