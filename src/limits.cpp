@@ -93,6 +93,7 @@ void validate(const Params& p) {
   in_range("remaining.shadow_baseline", p.remaining.shadow_baseline, -1, 1);
   in_range("remaining.occluded_jump", p.remaining.occluded_jump, 0, 1);
   in_range("remaining.hidden_coplanar_band", p.remaining.hidden_coplanar_band, 0, 1);
+  in_range("remaining.speck_band", p.remaining.speck_band, 0, 1);
   above("support.plane_band", p.support.plane_band, 0, 1);
   in_range("support.pixel_band", p.support.pixel_band, 0, 1);
   in_range("support.table_angle_deg", p.support.table_angle_deg, 0, 90);

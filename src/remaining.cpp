@@ -19,6 +19,8 @@
 //   meets in a convex edge (n_s - n_f) . (c_s - c_f) > 0, as faces of one object meet, not the table or
 //   the object it stands against (a concave crease).
 // - Beyond the paper: a table face (TableHint) takes no pixel standing clear of the table's plane.
+// - Beyond the paper: a segment whose one face is the table and that lies on the table around it (within
+//   Params::Remaining::speck_band of its ring's height) is the table's, before rules 1-3: a bump of noise.
 // - Beyond the paper: in rules 2-3 a segment seen behind its one face across depth jumps (most of its
 //   contacts with it, Params::Remaining::occluded_jump) and nowhere within the jump of it in space is an
 //   object that face hides, not a part of it. In rule 5 a face it is seen behind takes none of it.
@@ -167,6 +169,31 @@ bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, con
   return false;
 }
 
+// Median height above `plane` of at most ~256 of `pixels` (a stride: a large segment would cost a pass of its
+// own) that `take` accepts; NaN if none.
+template <typename Take>
+float median_height(std::span<const int> pixels, const cv::Vec3f* pts, const Plane& plane, Take take) {
+  std::vector<float> heights;
+  const size_t stride = std::max<size_t>(1, pixels.size() / 256);
+  for (size_t k = 0; k < pixels.size(); k += stride)
+    if (const int i = pixels[k]; take(i) && valid_point(pts[i])) heights.push_back(plane.distance({pts[i][0], pts[i][1], pts[i][2]}));
+  if (heights.empty()) return std::numeric_limits<float>::quiet_NaN();
+  std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2), heights.end());
+  return heights[heights.size() / 2];
+}
+
+// Beyond the paper (Params::Remaining::speck_band): whether a segment lies on the table around it, its median
+// height above the table's plane within `band` of the median of its ring's pixels on table face `label`. A
+// stereo camera's table lies a few mm off its fitted plane here and there, with bumps of noise on it.
+bool lies_on_table_around(std::span<const int> seg_pixels, const std::vector<int>& ring, int label,
+                                            const int* lab, const cv::Vec3f* pts, const TableHint& table, double band) {
+  const float ring_height = median_height(ring, pts, table.plane, [&](int j) { return lab[j] == label; });
+  const float seg_height = median_height(seg_pixels, pts, table.plane, [](int) { return true; });
+  if (!std::isfinite(ring_height) || !std::isfinite(seg_height)) return false;
+  const float z = pts[seg_pixels[seg_pixels.size() / 2]][2];
+  return std::abs(seg_height - ring_height) <= plane_tolerance(band, valid_depth(z) ? z : 1.f);
+}
+
 }  // namespace
 
 cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>& object_of_patch,
@@ -264,6 +291,9 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   // A point standing clear of the table's plane: no table face takes it.
   const auto clear_of_table = [&](const cv::Vec3f& q) {
     return table && table->plane.distance({q[0], q[1], q[2]}) > plane_tolerance(table->pixel_band, q[2]);
+  };
+  const auto on_table_around = [&](std::span<const int> seg_pixels, const std::vector<int>& ring, int label) {
+    return table && params.speck_band > 0 && lies_on_table_around(seg_pixels, ring, label, lab, pts, *table, params.speck_band);
   };
   // Beyond the paper: the object (id), not the occluder's (`occluder`), whose faces near a segment cut off
   // by an occluder hold at least kCoplanarShare of the segment's points on their local planes
@@ -365,12 +395,19 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     for (int i : seg_pixels) state[static_cast<size_t>(i)] = kGrown;
     for (int j : ring) state[static_cast<size_t>(j)] &= static_cast<uchar>(~kInRing);
     std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.label < b.label; });  // scan order free
+    // The table face of a segment that has no other face and is no tiny speck (which joins it or is noise), asked
+    // only where the rules below would not give the segment to the table anyway: it lies on the table around it.
+    const int table_face = faces.size() == 1 && is_table(faces[0].label) && static_cast<int>(seg_pixels.size()) >= tiny_px
+                               ? faces[0].label : 0;
+    bool speck = false;
     if (table && std::any_of(faces.begin(), faces.end(), [&](const Face& f) { return is_table(f.label); })) {
       // A segment mostly clear of the table is not the table's, whatever else it touches.
       int clear = 0;
       for (int i : seg_pixels) clear += clear_of_table(pts[i]);
-      if (2 * clear > static_cast<int>(seg_pixels.size()))
-        std::erase_if(faces, [&](const Face& f) { return is_table(f.label); });
+      if (2 * clear > static_cast<int>(seg_pixels.size())) {
+        speck = table_face > 0 && on_table_around(seg_pixels, ring, table_face);
+        if (!speck) std::erase_if(faces, [&](const Face& f) { return is_table(f.label); });
+      }
     }
     auto set_all = [&](int object_id) { for (int i : seg_pixels) obj[i] = object_id; };
     // Seen behind the face (most contacts across a jump) and meeting it nowhere in space: hidden by it.
@@ -402,8 +439,11 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const bool grazing = face.ring < params.min_contact_share * static_cast<double>(ring.size());
       // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
       // near it in space, the segment is an object that face hides, not a part of it.
+      // Beyond the paper: on the table around it, enclosed or grazing, a bump of noise is the table's.
+      if (!tiny && (enclosed || grazing) && !speck && face.label == table_face)
+        speck = on_table_around(seg_pixels, ring, table_face);
       if (!tiny && hidden_by(face)) set_all(hidden_object(face));
-      else set_all(!tiny && (enclosed || grazing) ? ++next_object : object_of(face.label));
+      else set_all(!tiny && (enclosed || grazing) && !speck ? ++next_object : object_of(face.label));
       continue;
     }
     // Beyond the paper: a face the segment is seen behind (most of their contacts across a jump) hides it and

@@ -178,6 +178,10 @@ struct Params {
                                  // comes nowhere this near it in space, is an object that face hides, not a
                                  // part of it; among several faces (rule 5) such a face takes none of it
                                  // [m]; 0 = off (remaining.hpp)
+    double speck_band = 0.005;   // beyond the paper: a segment whose one face is the table and whose median height
+                                 // above the table's plane lies within this of its ring's table pixels' is the
+                                 // table's (a bump of stereo noise on a table a few mm off its fitted plane), not
+                                 // an object that the table encloses [m at 1 m, times z^2 beyond]; 0 = off
     double hidden_coplanar_band = 0.008;  // beyond the paper (the co-planarity cue f/g for a remaining segment):
                                  // a segment hidden behind its face whose points lie within this of the
                                  // plane of a flat face of another object near it joins that object, the
