@@ -185,8 +185,8 @@ float median_height(std::span<const int> pixels, const cv::Vec3f* pts, const Pla
 // Beyond the paper (Params::Remaining::speck_band): whether a segment lies on the table around it, its median
 // height above the table's plane within `band` of the median of its ring's pixels on table face `label`. A
 // stereo camera's table lies a few mm off its fitted plane here and there, with bumps of noise on it.
-bool lies_on_table_around(std::span<const int> seg_pixels, const std::vector<int>& ring, int label,
-                                            const int* lab, const cv::Vec3f* pts, const TableHint& table, double band) {
+bool lies_on_table_around(std::span<const int> seg_pixels, const std::vector<int>& ring, int label, const int* lab,
+                          const cv::Vec3f* pts, const TableHint& table, double band) {
   const float ring_height = median_height(ring, pts, table.plane, [&](int j) { return lab[j] == label; });
   const float seg_height = median_height(seg_pixels, pts, table.plane, [](int) { return true; });
   if (!std::isfinite(ring_height) || !std::isfinite(seg_height)) return false;
@@ -437,11 +437,11 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       const bool enclosed = !touches_border && other_segment == 0 && face.ring >= invalid;  // rule 3
       // Beyond the paper: touching its one face in a pixel or two of its ring, the segment is no part of it.
       const bool grazing = face.ring < params.min_contact_share * static_cast<double>(ring.size());
-      // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
-      // near it in space, the segment is an object that face hides, not a part of it.
       // Beyond the paper: on the table around it, enclosed or grazing, a bump of noise is the table's.
       if (!tiny && (enclosed || grazing) && !speck && face.label == table_face)
         speck = on_table_around(seg_pixels, ring, table_face);
+      // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
+      // near it in space, the segment is an object that face hides, not a part of it.
       if (!tiny && hidden_by(face)) set_all(hidden_object(face));
       else set_all(!tiny && (enclosed || grazing) && !speck ? ++next_object : object_of(face.label));
       continue;
