@@ -79,6 +79,13 @@ std::vector<PairJunction> classify_junctions(const std::vector<Contact>& contact
   return out;
 }
 
+const PairJunction* junction_of(const std::vector<PairJunction>& junctions, int a, int b) {
+  const PatchPair pair(std::min(a, b), std::max(a, b));
+  const auto j = std::lower_bound(junctions.begin(), junctions.end(), pair,
+                                  [](const PairJunction& x, const PatchPair& p) { return x.pair < p; });
+  return j != junctions.end() && j->pair == pair ? &*j : nullptr;
+}
+
 std::vector<PatchPair> contacts_across_tops(const std::vector<PairJunction>& junctions, std::span<const Patch> patches,
                                             const cv::Mat& points, const Eigen::Vector3f& up,
                                             const Params::Convexity& params) {
@@ -86,12 +93,6 @@ std::vector<PatchPair> contacts_across_tops(const std::vector<PairJunction>& jun
   if (params.top_angle_deg <= 0 || points.type() != CV_32FC3) return out;
   const auto* pts = points.ptr<cv::Vec3f>();
   const float top_cos = static_cast<float>(std::cos(params.top_angle_deg * M_PI / 180.0));
-  const auto kind_of = [&](int a, int b) -> const PairJunction* {
-    const PatchPair pair(std::min(a, b), std::max(a, b));
-    const auto j = std::lower_bound(junctions.begin(), junctions.end(), pair,
-                                    [](const PairJunction& x, const PatchPair& p) { return x.pair < p; });
-    return j != junctions.end() && j->pair == pair ? &*j : nullptr;
-  };
   // Whether `side` (+1 above, -1 below) holds 90 % of a patch's points, the plane through the top face's
   // centroid along its mean normal (a noisy top's normals need not fit a plane).
   const auto on_side = [&](const Patch& patch, const Patch& top, int side) {
@@ -121,7 +122,7 @@ std::vector<PatchPair> contacts_across_tops(const std::vector<PairJunction>& jun
         if (edge.kind != Junction::Convex || (edge.pair.first != b && edge.pair.second != b)) continue;
         const int c = edge.pair.first == b ? edge.pair.second : edge.pair.first;
         if (c == a || c < 0 || c >= n) continue;
-        const PairJunction* touching = kind_of(a, c);
+        const PairJunction* touching = junction_of(junctions, a, c);
         if (!touching || touching->kind == Junction::Concave || touching->kind == Junction::Step) continue;
         if (on_side(patches[static_cast<size_t>(c)], top, -1)) out.emplace_back(std::min(a, c), std::max(a, c));
       }

@@ -253,6 +253,33 @@ bool one_surface(const CurvatureCentre& a, const CurvatureCentre& b, double shar
          b.distance(a.point) <= share * r;
 }
 
+// Each patch's convexity and centre of curvature, computed the first time a rule asks (most pairs are decided
+// without them).
+class PatchShapes {
+ public:
+  PatchShapes(const std::vector<Patch>& patches, const cv::Mat& points, const NormalPlanes& normals)
+      : patches_(patches), points_(points), normals_(normals), convex_(patches.size(), kUnknown), centres_(patches.size()) {}
+  int convexity_of(int i) {
+    int& c = convex_[static_cast<size_t>(i)];
+    const Patch& patch = patches_[static_cast<size_t>(i)];
+    if (c == kUnknown) c = convexity(patch, points_, normals_, histogram_side(patch.histogram));
+    return c;
+  }
+  const CurvatureCentre& centre_of(int i) {
+    auto& c = centres_[static_cast<size_t>(i)];
+    if (!c) c = curvature_centre(patches_[static_cast<size_t>(i)], points_, normals_);
+    return *c;
+  }
+
+ private:
+  static constexpr int kUnknown = 2;
+  const std::vector<Patch>& patches_;
+  const cv::Mat& points_;
+  const NormalPlanes& normals_;
+  std::vector<int> convex_;
+  std::vector<std::optional<CurvatureCentre>> centres_;
+};
+
 }  // namespace
 
 double histogram_similarity(const std::vector<float>& a, const std::vector<float>& b) {
@@ -353,24 +380,15 @@ std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, co
   // core box grown by that radius holds all of the patch's assigned pixels.
   const int assign_radius = px.length(params.adjacency.radius_px);
   auto box_of = [&](const Patch& patch) { return grown(patch.bbox, assign_radius); };
-  std::vector<int> convex(patches.size(), 2);  // 2 = not computed yet
-  auto convexity_of = [&](int i) {
-    auto& c = convex[static_cast<size_t>(i)];
-    if (c == 2) c = convexity(patches[static_cast<size_t>(i)], points, normals, histogram_side(patches[static_cast<size_t>(i)].histogram));
-    return c;
-  };
+  PatchShapes shapes(patches, points, normals);
+  const auto convexity_of = [&](int i) { return shapes.convexity_of(i); };
+  const auto centre_of = [&](int i) -> const CurvatureCentre& { return shapes.centre_of(i); };
   // An open object's walls whose histograms differ (a bowl's outer wall faces down and out, the inside
   // seen over the rim up and in): opposite convexity, and concentric (beyond the paper). Decided here, so
   // that the boundary pass below covers only the pairs left. Boxes first: most pairs lie apart in the
   // image, and their convexity is not needed.
   const auto apart = [&](int i, int j) {
     return (grown(box_of(patches[static_cast<size_t>(i)]), gap) & box_of(patches[static_cast<size_t>(j)])).area() == 0;
-  };
-  std::vector<std::optional<CurvatureCentre>> centres(patches.size());  // fitted the first time a pair needs one
-  auto centre_of = [&](int i) -> const CurvatureCentre& {
-    auto& c = centres[static_cast<size_t>(i)];
-    if (!c) c = curvature_centre(patches[static_cast<size_t>(i)], points, normals);
-    return *c;
   };
   std::erase_if(walls, [&](const PatchPair& pair) {
     const auto [i, j] = pair;
@@ -450,20 +468,9 @@ std::vector<PatchPair> creases_inside(const std::vector<Patch>& patches, const s
                                       const cv::Mat& points, const NormalPlanes& normals, double share) {
   std::vector<PatchPair> out;
   if (share <= 0) return out;
-  // Each patch's convexity and centre once (a patch meets several others; few pairs per frame are concave).
-  std::vector<int> convex(patches.size(), 2);  // 2 = not computed yet
-  std::vector<std::optional<CurvatureCentre>> centres(patches.size());
-  const auto concave = [&](int i) {
-    const Patch& patch = patches[static_cast<size_t>(i)];
-    int& c = convex[static_cast<size_t>(i)];
-    if (c == 2) c = convexity(patch, points, normals, histogram_side(patch.histogram));
-    return c == -1;
-  };
-  const auto centre_of = [&](int i) -> const CurvatureCentre& {
-    auto& c = centres[static_cast<size_t>(i)];
-    if (!c) c = curvature_centre(patches[static_cast<size_t>(i)], points, normals);
-    return *c;
-  };
+  PatchShapes shapes(patches, points, normals);  // a patch meets several others
+  const auto concave = [&](int i) { return shapes.convexity_of(i) == -1; };
+  const auto centre_of = [&](int i) -> const CurvatureCentre& { return shapes.centre_of(i); };
   // The centres first: on most creases (a box on a box, a can on a book) one side has none. Creases with the
   // table are no link of the graph.
   const auto candidate = [&](int i) { return patches[static_cast<size_t>(i)].curved && !patches[static_cast<size_t>(i)].table; };

@@ -44,14 +44,12 @@ std::vector<GraphEdge> patch_graph(const std::vector<Patch>& patches, const std:
                                    const std::vector<CurvatureLink>& curved, const Params::Convexity& convexity) {
   std::vector<GraphEdge> links;
   for (const auto& [a, b] : adjacent) {
-    const auto j = std::lower_bound(junctions.begin(), junctions.end(), PatchPair(a, b),
-                                    [](const PairJunction& x, const PatchPair& p) { return x.pair < p; });
-    const bool crease = j != junctions.end() && j->pair == PatchPair(a, b) &&
-                        (j->kind == Junction::Concave || j->kind == Junction::Step);
+    const PairJunction* j = junction_of(junctions, a, b);
+    const bool crease = j && (j->kind == Junction::Concave || j->kind == Junction::Step);
     const bool concave = (crease || std::binary_search(across.begin(), across.end(), PatchPair(a, b))) &&
                          !std::binary_search(inside.begin(), inside.end(), PatchPair(a, b));
     links.push_back({a, b, concave ? Cue::AdjacentConcave : Cue::Adjacent, 0,
-                     j != junctions.end() && j->pair == PatchPair(a, b) ? j->convexity : std::numeric_limits<float>::quiet_NaN()});
+                     j ? j->convexity : std::numeric_limits<float>::quiet_NaN()});
   }
   for (const auto& [a, b] : coplanar) links.push_back({a, b, Cue::Coplanar, 0});
   for (const auto& c : curved)

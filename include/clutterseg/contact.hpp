@@ -39,6 +39,9 @@ std::vector<PairJunction> classify_junctions(const std::vector<Contact>& contact
                                              const NormalPlanes& normals, const Params::Convexity& params,
                                              std::span<const Patch> patches = {});
 
+// The junction of patches a and b (either order) in `junctions` (sorted by pair); nullptr if they have none.
+const PairJunction* junction_of(const std::vector<PairJunction>& junctions, int a, int b);
+
 // Beyond the paper (Params::Convexity::top_angle_deg): the links between an object resting on a top face and
 // the faces below that face's edge. A patch A meets a top face B (mean normal within top_angle_deg of `up`) in
 // a concave crease and lies above B's plane; a patch C meets B in a convex edge and lies below that plane (B's
