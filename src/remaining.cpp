@@ -24,6 +24,9 @@
 // - Beyond the paper: in rules 2-3 a segment seen behind its one face across depth jumps (most of its
 //   contacts with it, Params::Remaining::occluded_jump) and nowhere within the jump of it in space is an
 //   object that face hides, not a part of it. In rule 5 a face it is seen behind takes none of it.
+// - Beyond the paper: the same for a face the segment stands before (jumps with the segment in front, nowhere
+//   near in space, Params::Remaining::in_front) when the segment is concave to it; convex to it, it is the
+//   face's rim (a bowl's outer wall before its inside).
 // - Beyond the paper: in rule 3 a segment whose one face holds less than Params::Remaining::min_contact_share of
 //   its ring (a pan's wall without a patch that grazes a cup beside it) is an object of its own, not a part of it.
 // - Beyond the paper: in rules 1-3 a segment that would be an object of its own (hidden behind its one face,
@@ -105,6 +108,33 @@ constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
 const float kOwnFaceCos = static_cast<float>(std::cos(30.0 * M_PI / 180.0));
 // Convexity (contact.hpp) above which a face of its own joins a neighbouring face.
 constexpr float kConvex = 0.1f;
+
+// A surface's mean normal and centroid (over its pixels with a normal); false when there are fewer than three
+// or their normals disagree too much to average (a curved segment).
+struct MeanNormal {
+  Eigen::Vector3f normal, centroid;
+};
+std::optional<MeanNormal> mean_normal(std::span<const int> pixels, const NormalPlanes& normals, const cv::Vec3f* pts) {
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero(), centroid = Eigen::Vector3f::Zero();
+  int n = 0;
+  for (int i : pixels) {
+    const Eigen::Vector3f ni(normals[0].ptr<float>()[i], normals[1].ptr<float>()[i], normals[2].ptr<float>()[i]);
+    if (ni.squaredNorm() < 0.5f) continue;  // no normal here
+    normal += ni;
+    centroid += Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
+    ++n;
+  }
+  if (n < 3 || !(normal.norm() > 0.5f * static_cast<float>(n))) return std::nullopt;
+  return MeanNormal{normal.normalized(), centroid / static_cast<float>(n)};
+}
+
+// Convexity (n_s - n_f) . (c_s - c_f) / |c_s - c_f| of a segment against a face's local plane (contact.hpp);
+// NaN when the centroids coincide.
+float convexity(const MeanNormal& segment, const Eigen::Vector3f& face_normal, const Eigen::Vector3f& face_centroid) {
+  const Eigen::Vector3f d = segment.centroid - face_centroid;
+  if (!(d.norm() > 1e-4f)) return std::numeric_limits<float>::quiet_NaN();
+  return (segment.normal - face_normal).dot(d) / d.norm();
+}
 
 // Least-squares plane of the pixels labelled `patch` in `window` (visited with a stride so that at most
 // about kMaxVisits pixels are read). Returns false when they are too few or collinear.
@@ -273,10 +303,11 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   int next_object = num_objects;
   std::vector<int> ring;                      // per segment: its ring pixels
   // A neighbouring face of a segment: its ring pixels on the face, and (for a non-table face) how many of
-  // them lie across a depth jump with the segment behind, or not.
+  // them lie across a depth jump with the segment behind, across one with the segment in front, or on neither.
   struct Face {
-    int label, ring = 0, behind = 0, touching = 0;
-    bool hides() const { return behind > kHiddenRatio * touching; }  // contacts mostly across a jump
+    int label, ring = 0, behind = 0, front = 0, touching = 0;
+    bool hides() const { return behind > kHiddenRatio * touching; }           // contacts mostly across a jump
+    bool apart() const { return behind + front > kHiddenRatio * touching; }  // either way round
   };
   std::vector<Face> faces;  // per segment, sorted by label
   struct FacePlane {
@@ -383,7 +414,9 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
           if (face == faces.end()) face = faces.insert(faces.end(), Face{lab[j]});
           ++face->ring;
           if (occluded_jump2 > 0 && !is_table(lab[j])) {
-            if (distance2(pts[i], pts[j]) > occluded_jump2 && pts[i][2] > pts[j][2]) ++face->behind; else ++face->touching;
+            if (distance2(pts[i], pts[j]) <= occluded_jump2) ++face->touching;
+            else if (pts[i][2] > pts[j][2]) ++face->behind;
+            else ++face->front;
           }
         } else if (state[static_cast<size_t>(j)] == (kGrown | kInRing)) {
           ++other_segment;
@@ -411,8 +444,27 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     }
     auto set_all = [&](int object_id) { for (int i : seg_pixels) obj[i] = object_id; };
     // Seen behind the face (most contacts across a jump) and meeting it nowhere in space: hidden by it.
-    const auto hidden_by = [&](const Face& f) {
-      return f.hides() && !meets_in_space(seg_pixels, seg.bbox, assigned_labels, points, f.label, static_cast<float>(params.occluded_jump));
+    const auto meets = [&](const Face& f) {
+      return meets_in_space(seg_pixels, seg.bbox, assigned_labels, points, f.label, static_cast<float>(params.occluded_jump));
+    };
+    const auto hidden_by = [&](const Face& f) { return f.hides() && !meets(f); };
+    // The segment's mean normal, computed when first asked for.
+    std::optional<MeanNormal> own_normal;
+    bool own_normal_known = false;
+    const auto segment_normal = [&]() -> const std::optional<MeanNormal>& {
+      if (!own_normal_known && have_normals) own_normal = mean_normal(seg_pixels, normals, pts);
+      own_normal_known = true;
+      return own_normal;
+    };
+    // Seen in front of the face across jumps, meeting it nowhere in space and not convex to it: a thing standing
+    // before the face (a box's steep face before a cylinder), not its rim (a bowl's wall before its inside is
+    // convex to it, as the paper's open objects).
+    const auto in_front_of = [&](const Face& f) {
+      if (!params.in_front || !f.apart() || f.hides() || !segment_normal()) return false;
+      Plane plane;
+      Eigen::Vector3f centroid;
+      return fit_plane_near(assigned_labels, points, f.label, seg.bbox, plane, centroid) &&
+             convexity(*segment_normal(), plane.normal, centroid) < 0.f && !meets(f);
     };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
     // A hidden segment (not tiny): the far part of an object the face cuts in two (co-planarity, f/g), or an
@@ -442,14 +494,14 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         speck = on_table_around(seg_pixels, ring, table_face);
       // Beyond the paper: seen behind its one face (most of their contacts across a depth jump) and nowhere
       // near it in space, the segment is an object that face hides, not a part of it.
-      if (!tiny && hidden_by(face)) set_all(hidden_object(face));
+      if (!tiny && (hidden_by(face) || in_front_of(face))) set_all(hidden_object(face));
       else set_all(!tiny && (enclosed || grazing) && !speck ? ++next_object : object_of(face.label));
       continue;
     }
     // Beyond the paper: a face the segment is seen behind (most of their contacts across a jump) hides it and
     // takes none of it; hidden behind every face, it is an object of its own (or of the far part's, as above).
     const Face longest = *std::max_element(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.ring < b.ring; });
-    std::erase_if(faces, [](const Face& f) { return f.hides(); });
+    std::erase_if(faces, [&](const Face& f) { return f.hides() || in_front_of(f); });
     if (faces.empty()) {
       set_all(static_cast<int>(seg_pixels.size()) < tiny_px ? object_of(longest.label) : hidden_object(longest));
       continue;
@@ -473,29 +525,16 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       continue;
     }
     // A face of its own joins the face it meets in the most convex edge.
-    if (have_normals) {
-      Eigen::Vector3f normal = Eigen::Vector3f::Zero(), centroid = Eigen::Vector3f::Zero();
-      int n = 0;
-      for (int i : seg_pixels) {
-        const Eigen::Vector3f ni(normals[0].ptr<float>()[i], normals[1].ptr<float>()[i], normals[2].ptr<float>()[i]);
-        if (ni.squaredNorm() < 0.5f) continue;  // no normal here
-        normal += ni;
-        centroid += Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
-        ++n;
-      }
-      if (n >= 3 && normal.norm() > 0.5f * static_cast<float>(n)) {  // normals that agree enough to average
-        normal.normalize();
-        centroid /= static_cast<float>(n);
-        const bool own_face = std::all_of(planes.begin(), planes.end(), [&](const FacePlane& f) {
-          return std::abs(normal.dot(f.plane.normal)) < kOwnFaceCos;
-        });
+    if (const auto& own = segment_normal()) {
+      const bool own_face = std::all_of(planes.begin(), planes.end(), [&](const FacePlane& f) {
+        return std::abs(own->normal.dot(f.plane.normal)) < kOwnFaceCos;
+      });
+      if (own_face) {
         const FacePlane* best = nullptr;
         float best_convexity = kConvex;
         for (const FacePlane& f : planes) {
-          const Eigen::Vector3f d = centroid - f.centroid;
-          if (!own_face || f.table || !(d.norm() > 1e-4f)) continue;
-          const float convexity = (normal - f.plane.normal).dot(d) / d.norm();
-          if (convexity > best_convexity) { best_convexity = convexity; best = &f; }
+          const float c = f.table ? std::numeric_limits<float>::quiet_NaN() : convexity(*own, f.plane.normal, f.centroid);
+          if (c > best_convexity) { best_convexity = c; best = &f; }
         }
         if (best) {
           set_all(best->object_id);

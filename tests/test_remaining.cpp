@@ -187,6 +187,38 @@ TEST(Remaining, AFaceTheSegmentIsSeenBehindTakesNoneOfIt) {
   EXPECT_NE(run(1.0f, 0), 3);       // off: rule 5 gives it to a face's object by its plane
 }
 
+// Beyond the paper (Params::Remaining::in_front): a segment seen in front of a face across depth jumps, nowhere
+// near it in space, with a normal that makes it concave to the face, stands before that face and is no part
+// of it (complex-000016: a thin box's steep face, with no patch, before a lying cylinder went to the
+// cylinder). Convex to the face, as a bowl's outer wall is to the inside it hides, it still joins it.
+TEST(Remaining, ASegmentStandingBeforeItsFaceConcavelyIsNoPartOfIt) {
+  // Face 1 in columns 0-19 at 1.2 m, the segment (600 px, at the border: not enclosed) in columns 20-39 at
+  // 1.12 m, 8 cm in front; with `occluder`, object 2 in front of the segment's left part hides it there.
+  const auto run = [](float normal_x, bool in_front, bool occluder = false) {
+    Case c;
+    c.depth.colRange(0, 20).setTo(1.2f);
+    c.labels.colRange(0, 20).setTo(1);
+    c.depth.colRange(20, 40).setTo(1.12f);
+    if (occluder) {
+      c.depth(cv::Rect(34, 0, 6, 30)).setTo(1.0f);
+      c.labels(cv::Rect(34, 0, 6, 30)).setTo(2);
+    }
+    cv::Mat nx(c.depth.size(), CV_32F, cv::Scalar(0)), ny = nx.clone(), nz(c.depth.size(), CV_32F, cv::Scalar(-1));
+    const float tilt = std::sqrt(1 - normal_x * normal_x);
+    nx.colRange(20, 40).setTo(normal_x);  // facing left (towards the face) or right, and the camera
+    nz.colRange(20, 40).setTo(-tilt);
+    Params::Remaining params;
+    params.in_front = in_front;
+    return assign_remaining(c.labels, {0, 1}, 2, c.points(), NormalPlanes{nx, ny, nz}, params, 20).at<int>(15, 25);
+  };
+  EXPECT_EQ(run(-0.6f, true), 3);   // facing the face: concave to it, an object of its own
+  EXPECT_EQ(run(-0.6f, false), 1);  // off: rule 3, not enclosed, joins the face
+  EXPECT_EQ(run(0.6f, true), 1);    // facing away: convex to it (a bowl's wall before its inside), joins
+  // Between an occluder that hides it and the face it stands before: neither takes it (rule 5's faces).
+  EXPECT_EQ(run(-0.6f, true, true), 3);
+  EXPECT_EQ(run(-0.6f, false, true), 1);
+}
+
 // Beyond the paper (Params::Remaining::hidden_coplanar_band): a box behind a nearer one, cut in two by it.
 // Its right part is a face (object 2), its left part a segment with no patch (too small and too far for
 // one), hidden behind the occluder (object 1) or cut off from it by the occluder's shadow (no depth: rule 1).

@@ -178,6 +178,10 @@ struct Params {
                                  // comes nowhere this near it in space, is an object that face hides, not a
                                  // part of it; among several faces (rule 5) such a face takes none of it
                                  // [m]; 0 = off (remaining.hpp)
+    bool in_front = true;        // beyond the paper: ... and so is a segment that meets its face mostly across such
+                                 // jumps in front of it, nowhere near it in space, concave to it (a thin box's steep
+                                 // face with no patch before a cylinder; a bowl's wall, convex to its inside, stays
+                                 // with it); false = only a segment behind its face
     double speck_band = 0.005;   // beyond the paper: a segment whose one face is the table and whose median height
                                  // above the table's plane lies within this of its ring's table pixels' is the
                                  // table's (a bump of stereo noise on a table a few mm off its fitted plane), not

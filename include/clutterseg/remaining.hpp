@@ -24,7 +24,8 @@ struct TableHint {
 // applying the paper's five rules; new objects get ids after the existing ones. A segment of several
 // objects' faces that is a face of its own (its normals differ from every neighbouring face's) joins the
 // face it meets in a convex edge, and a segment seen behind its one face across depth jumps larger than
-// params.occluded_jump is an object of its own (both beyond the paper; docs/OBJECTS.md). tiny_px is
+// params.occluded_jump, or before it and concave to it (params.in_front), is an object of its own (both beyond
+// the paper; docs/OBJECTS.md). tiny_px is
 // already scaled to the resolution. normals may be empty (no face-of-its-own rule). With `occlusion`, a
 // segment that would be an object of its own but lies on the planes of another object's faces near it, with
 // only nearer things between, joins that object (params.hidden_coplanar_band; without it, no such joins).
