@@ -27,6 +27,8 @@
 // - Beyond the paper: the same for a face the segment stands before (jumps with the segment in front, nowhere
 //   near in space, Params::Remaining::in_front) when the segment is concave to it; convex to it, it is the
 //   face's rim (a bowl's outer wall before its inside).
+// - Beyond the paper: in rule 5 a face resting on a top face of another object takes no pixel below that top's
+//   plane (Params::Remaining::below_tops): a box's front under a can standing flush with it.
 // - Beyond the paper: in rule 3 a segment whose one face holds less than Params::Remaining::min_contact_share of
 //   its ring (a pan's wall without a patch that grazes a cup beside it) is an object of its own, not a part of it.
 // - Beyond the paper: in rules 1-3 a segment that would be an object of its own (hidden behind its one face,
@@ -108,6 +110,8 @@ constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
 const float kOwnFaceCos = static_cast<float>(std::cos(30.0 * M_PI / 180.0));
 // Convexity (contact.hpp) above which a face of its own joins a neighbouring face.
 constexpr float kConvex = 0.1f;
+// A face facing up within this of the table's normal is a top face (as convexity.top_angle_deg).
+const float kTopCos = static_cast<float>(std::cos(20.0 * M_PI / 180.0));
 
 // A surface's mean normal and centroid (over its pixels with a normal); false when there are fewer than three
 // or their normals disagree too much to average (a curved segment).
@@ -154,14 +158,21 @@ bool fit_local_plane(const cv::Mat& labels, const cv::Mat& points, int patch, cv
   return true;
 }
 
+// `box` grown by `margin` pixels on every side, within the image.
+cv::Rect grown(const cv::Rect& box, int margin, const cv::Mat& image) {
+  return cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
+         cv::Rect(0, 0, image.cols, image.rows);
+}
+
+// The margin of the window around a segment's box in which a face's local plane is fitted first.
+int first_margin(const cv::Rect& bbox) { return std::max(8, std::max(bbox.width, bbox.height) / 2); }
+
 // Whether some point of `segment` lies within `distance` (3D) of a point of `patch` in the segment's box
 // grown by its size: a surface that meets the face in space (a cylinder's top its side), not only in the
 // image (an object behind an occluder). Both sides are sampled (at most kMaxVisits face points).
 bool meets_in_space(std::span<const int> segment, const cv::Rect& bbox, const cv::Mat& labels, const cv::Mat& points,
                     int patch, float distance) {
-  const cv::Rect image(0, 0, labels.cols, labels.rows);
-  const int margin = std::max(bbox.width, bbox.height);
-  const cv::Rect window = cv::Rect(bbox.x - margin, bbox.y - margin, bbox.width + 2 * margin, bbox.height + 2 * margin) & image;
+  const cv::Rect window = grown(bbox, std::max(bbox.width, bbox.height), labels);
   const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
   std::vector<Eigen::Vector3f> face;
   for (int y = window.y; y < window.y + window.height; y += stride) {
@@ -186,13 +197,87 @@ bool meets_in_space(std::span<const int> segment, const cv::Rect& bbox, const cv
   return false;
 }
 
+// Whether the points of `patch` near `bbox` (the window of its local plane, a stride: at most about kMaxVisits read) rest on
+// `top`: at least 95 % of them above its plane or less than `band` (plane_tolerance) below it, their mean above
+// it by more than that, and at least 5 % of them within kRestingHeight of it (touching it: not a surface far
+// behind that only lies above the top's plane extended); false when fewer than 10.
+constexpr float kRestingHeight = 0.02f;
+bool rests_on(const cv::Mat& labels, const cv::Mat& points, int patch, const cv::Rect& bbox, const Plane& top, double band) {
+  const cv::Rect window = grown(bbox, first_margin(bbox), labels);
+  const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
+  int n = 0, below = 0, low = 0;
+  double height = 0;
+  for (int y = window.y; y < window.y + window.height; y += stride) {
+    const int* lab = labels.ptr<int>(y);
+    const auto* pts = points.ptr<cv::Vec3f>(y);
+    for (int x = window.x; x < window.x + window.width; x += stride) {
+      if (lab[x] != patch || !valid_point(pts[x])) continue;
+      const float h = top.distance({pts[x][0], pts[x][1], pts[x][2]});
+      below += h < -plane_tolerance(band, pts[x][2]);
+      low += h < kRestingHeight;
+      height += h;
+      ++n;
+    }
+  }
+  return n >= 10 && below <= n / 20 && 20 * low >= n && height / n > plane_tolerance(band, 1.f);
+}
+
+// A cylinder through a curved face: its axis is the direction its normals are all across (the least
+// eigenvector of sum n n^T), its centre line where the normal lines meet in the plane across it (least
+// squares), its radius the mean distance of the points to that line.
+struct Cylinder {
+  Eigen::Vector3d point, axis;
+  double radius = 0;
+  double distance(const Eigen::Vector3d& x) const {  // from the surface
+    const Eigen::Vector3d d = x - point;
+    return std::abs((d - d.dot(axis) * axis).norm() - radius);
+  }
+};
+// Normals within ~18 deg of across the axis (sin^2 share of the largest eigenvalue), turning by ~8 deg at least
+// (a plane's do not), radius below kMaxRadius.
+constexpr double kAcrossAxis = 0.1, kTurning = 0.02, kMaxRadius = 0.3;
+std::optional<Cylinder> fit_cylinder(const std::vector<int>& pixels, const cv::Vec3f* pts, const NormalPlanes& normals) {
+  const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> sample;  // (point, normal)
+  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+  for (int i : pixels) {
+    const Eigen::Vector3d n(nx[i], ny[i], nz[i]);
+    if (!valid_point(pts[i]) || n.squaredNorm() < 0.5) continue;
+    sample.emplace_back(Eigen::Vector3d(pts[i][0], pts[i][1], pts[i][2]), n.normalized());
+    spread += sample.back().second * sample.back().second.transpose();
+  }
+  if (sample.size() < 10) return std::nullopt;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(spread);  // eigenvalues ascending
+  const Eigen::Vector3d lambda = eig.eigenvalues();
+  if (!(lambda(2) > 0) || lambda(0) > kAcrossAxis * lambda(2) || lambda(1) < kTurning * lambda(2)) return std::nullopt;
+  Cylinder c;
+  c.axis = eig.eigenvectors().col(0);
+  const Eigen::Matrix3d across_axis = Eigen::Matrix3d::Identity() - c.axis * c.axis.transpose();
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const auto& [p, n] : sample) {
+    const Eigen::Vector3d m = (across_axis * n).normalized();
+    const Eigen::Matrix3d off_line = across_axis - m * m.transpose();  // in the plane across the axis, off the line
+    a += off_line;
+    b += off_line * p;
+  }
+  a += c.axis * c.axis.transpose();  // the centre's position along the axis: pinned at 0 (b has no part there)
+  c.point = a.ldlt().solve(b);
+  for (const auto& [p, n] : sample) {
+    const Eigen::Vector3d d = p - c.point;
+    c.radius += (d - d.dot(c.axis) * c.axis).norm();
+  }
+  c.radius /= static_cast<double>(sample.size());
+  if (!std::isfinite(c.radius) || c.radius > kMaxRadius) return std::nullopt;
+  return c;
+}
+
 // Plane of `patch` near `bbox`: the window grows until the fit is possible (bounded: whole image).
 bool fit_plane_near(const cv::Mat& labels, const cv::Mat& points, int patch, const cv::Rect& bbox, Plane& plane,
                     Eigen::Vector3f& centroid) {
   const cv::Rect image(0, 0, labels.cols, labels.rows);
-  int margin = std::max(8, std::max(bbox.width, bbox.height) / 2);
-  for (int attempt = 0; attempt < 8; ++attempt, margin *= 2) {
-    const cv::Rect window = cv::Rect(bbox.x - margin, bbox.y - margin, bbox.width + 2 * margin, bbox.height + 2 * margin) & image;
+  for (int attempt = 0, margin = first_margin(bbox); attempt < 8; ++attempt, margin *= 2) {
+    const cv::Rect window = grown(bbox, margin, labels);
     if (fit_local_plane(labels, points, patch, window, plane, centroid)) return true;
     if (window == image) break;
   }
@@ -315,8 +400,10 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     Eigen::Vector3f centroid;
     int object_id;
     bool table;
+    int label;
   };
   std::vector<FacePlane> planes;  // per segment in rule 5
+  std::vector<std::pair<size_t, size_t>> resting;  // per segment in rule 5: (face, top face it rests on)
   const float occluded_jump2 = static_cast<float>(params.occluded_jump * params.occluded_jump);
   const auto is_table = [&](int patch_label) { return table && table->table_patch[static_cast<size_t>(patch_label - 1)]; };
   // A point standing clear of the table's plane: no table face takes it.
@@ -334,15 +421,14 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   // segment's box grown by twice its size on every side (an occluder twice as wide as the segment), read
   // with a stride (at most about kMaxVisits pixels); at most kCoplanarCandidates of them are fitted.
   std::vector<uchar> on_face;  // per segment pixel: on a face of the object looked at
+  std::vector<int> face_pixels;  // a face's pixels in the window, for a cylinder through them
   const auto coplanar_object = [&](std::span<const int> seg_pixels, const cv::Rect& bbox, int occluder) {
     const auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
     if (!occlusion) return 0;
     Eigen::Vector3f own_centroid = Eigen::Vector3f::Zero();
     for (int i : seg_pixels) own_centroid += Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
     own_centroid /= static_cast<float>(seg_pixels.size());
-    const int margin = 2 * std::max(bbox.width, bbox.height);
-    const cv::Rect window = cv::Rect(bbox.x - margin, bbox.y - margin, bbox.width + 2 * margin, bbox.height + 2 * margin) &
-                            cv::Rect(0, 0, width, height);
+    const cv::Rect window = grown(bbox, 2 * std::max(bbox.width, bbox.height), assigned_labels);
     const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
     std::vector<std::pair<int, int>> seen;  // (visits, patch label)
     for (int y = window.y; y < window.y + window.height; y += stride)
@@ -354,29 +440,46 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       }
     std::sort(seen.begin(), seen.end(), [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
     if (seen.size() > kCoplanarCandidates) seen.resize(kCoplanarCandidates);
-    // The faces that pass the occlusion check, with their planes, grouped by object below.
-    std::vector<std::pair<int, Plane>> faces_near;  // (object id, local plane)
+    // The faces that pass the occlusion check, with their planes (and, with params.hidden_curved, a cylinder
+    // through their pixels in the window), grouped by object below.
+    struct FaceNear {
+      int object;
+      Plane plane;
+      std::optional<Cylinder> cylinder;
+    };
+    std::vector<FaceNear> faces_near;
     for (const auto& [visits, l] : seen) {
       Plane plane;
       Eigen::Vector3f centroid;
       if (!fit_plane_near(assigned_labels, points, l, bbox, plane, centroid)) continue;
       if (behind_fraction(own_centroid, centroid, points, occlusion->camera, occlusion->tolerance) > occlusion->max_fraction)
         continue;  // background between them: not seen through a nearer thing
-      faces_near.emplace_back(object_of(l), plane);
+      std::optional<Cylinder> cylinder;
+      if (params.hidden_curved && have_normals) {
+        face_pixels.clear();
+        for (int y = window.y; y < window.y + window.height; y += stride)
+          for (int x = window.x; x < window.x + window.width; x += stride)
+            if (lab[y * width + x] == l) face_pixels.push_back(y * width + x);
+        cylinder = fit_cylinder(face_pixels, pts, normals);
+      }
+      faces_near.push_back({object_of(l), plane, cylinder});
     }
     int best_object = 0;
     double best_share = kCoplanarShare;
     for (size_t f = 0; f < faces_near.size(); ++f) {
-      const int object = faces_near[f].first;
-      if (std::any_of(faces_near.begin(), faces_near.begin() + static_cast<std::ptrdiff_t>(f), [&](const auto& g) { return g.first == object; }))
+      const int object = faces_near[f].object;
+      if (std::any_of(faces_near.begin(), faces_near.begin() + static_cast<std::ptrdiff_t>(f), [&](const auto& g) { return g.object == object; }))
         continue;  // this object was counted with its first face
       on_face.assign(seg_pixels.size(), 0);
       for (size_t g = f; g < faces_near.size(); ++g) {
-        if (faces_near[g].first != object) continue;
-        const Plane& plane = faces_near[g].second;
+        if (faces_near[g].object != object) continue;
+        const Plane& plane = faces_near[g].plane;
+        const std::optional<Cylinder>& cylinder = faces_near[g].cylinder;
         for (size_t k = 0; k < seg_pixels.size(); ++k) {
           const cv::Vec3f& q = pts[seg_pixels[k]];
-          on_face[k] |= std::abs(plane.distance({q[0], q[1], q[2]})) <= plane_tolerance(params.hidden_coplanar_band, q[2]);
+          const double band = plane_tolerance(params.hidden_coplanar_band, q[2]);
+          on_face[k] |= std::abs(plane.distance({q[0], q[1], q[2]})) <= band ||
+                        (cylinder && cylinder->distance(Eigen::Vector3d(q[0], q[1], q[2])) <= band);
         }
       }
       const double share = static_cast<double>(std::count(on_face.begin(), on_face.end(), 1)) / static_cast<double>(seg_pixels.size());
@@ -517,7 +620,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       Plane plane;
       Eigen::Vector3f centroid;
       if (fit_plane_near(assigned_labels, points, f.label, seg.bbox, plane, centroid))
-        planes.push_back({plane, centroid, object_of(f.label), is_table(f.label)});
+        planes.push_back({plane, centroid, object_of(f.label), is_table(f.label), f.label});
     }
     if (planes.empty()) {  // only degenerate faces: the face with the longest contact takes it
       const auto best = std::max_element(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.ring < b.ring; });
@@ -542,14 +645,31 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         }
       }
     }
+    // Beyond the paper: a face resting on a top face of another object (a neighbouring face facing up, within
+    // 20 deg of the table's normal) takes no pixel below that top's plane: a box's front below a can standing
+    // flush with it lies on the can's tangent plane, but not under the box's top.
+    resting.clear();
+    if (table && params.below_tops)
+      for (size_t t = 0; t < planes.size(); ++t) {
+        if (planes[t].table || planes[t].plane.normal.dot(table->plane.normal) < kTopCos) continue;
+        for (size_t f = 0; f < planes.size(); ++f)
+          if (!planes[f].table && planes[f].object_id != planes[t].object_id &&
+              rests_on(assigned_labels, points, planes[f].label, seg.bbox, planes[t].plane, table->pixel_band))
+            resting.emplace_back(f, t);
+      }
+    const auto under_its_top = [&](size_t f, const Eigen::Vector3f& q) {
+      return std::any_of(resting.begin(), resting.end(), [&](const auto& r) {
+        return r.first == f && planes[r.second].plane.distance(q) < -plane_tolerance(table->pixel_band, q.z());
+      });
+    };
     // Per pixel, the neighbouring face whose local plane fits best (no table face for a pixel clear of it).
     for (int i : seg_pixels) {
       const Eigen::Vector3f q(pts[i][0], pts[i][1], pts[i][2]);
       const bool clear = clear_of_table(pts[i]);
       float best = std::numeric_limits<float>::infinity();
-      for (const FacePlane& f : planes) {
-        const float d = std::abs(f.plane.distance(q));
-        if (d < best && !(clear && f.table)) { best = d; obj[i] = f.object_id; }
+      for (size_t f = 0; f < planes.size(); ++f) {
+        const float d = std::abs(planes[f].plane.distance(q));
+        if (d < best && !(clear && planes[f].table) && !under_its_top(f, q)) { best = d; obj[i] = planes[f].object_id; }
       }
     }
   }

@@ -186,11 +186,17 @@ struct Params {
                                  // above the table's plane lies within this of its ring's table pixels' is the
                                  // table's (a bump of stereo noise on a table a few mm off its fitted plane), not
                                  // an object that the table encloses [m at 1 m, times z^2 beyond]; 0 = off
+    bool below_tops = true;      // beyond the paper: in rule 5 a face resting on a top face of another object (95 %
+                                 // of its points near the segment above the top's plane) takes no pixel below that
+                                 // plane (a box's front below a can flush with it); false = the paper's plane fit
     double hidden_coplanar_band = 0.008;  // beyond the paper (the co-planarity cue f/g for a remaining segment):
                                  // a segment hidden behind its face whose points lie within this of the
                                  // plane of a flat face of another object near it joins that object, the
                                  // far part of an object the occluder cuts in two [m at 1 m, times z^2
                                  // beyond]; 0 = off (a new object, as occluded_jump alone)
+    bool hidden_curved = true;   // beyond the paper: ... or on the sphere or cylinder through such a face's pixels
+                                 // near it (their normals' centre of curvature; curvature's occluded cue for a
+                                 // segment: a lying cylinder's far part); false = planes only
   } remaining;
 
   // Beyond the paper: the support plane (table), decided per patch before the graph (support.hpp).
