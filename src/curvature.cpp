@@ -337,6 +337,46 @@ int convexity(const Patch& patch, const cv::Mat& points, const NormalPlanes& nor
   return correlation > kConvexityCorrelation ? 1 : correlation < -kConvexityCorrelation ? -1 : 0;
 }
 
+std::optional<Cylinder> fit_cylinder(const std::vector<int>& pixels, const cv::Mat& points, const NormalPlanes& normals) {
+  constexpr double kAcrossAxis = 0.1, kTurning = 0.02, kMaxRadius = 0.3;  // sin^2 shares of the largest eigenvalue
+  const auto* pts = points.ptr<cv::Vec3f>();
+  const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
+  const size_t stride = std::max<size_t>(1, pixels.size() / 512);
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> sample;  // (point, normal)
+  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < pixels.size(); k += stride) {
+    const int i = pixels[k];
+    const Eigen::Vector3d n(nx[i], ny[i], nz[i]);
+    if (!valid_point(pts[i]) || n.squaredNorm() < 0.5) continue;
+    sample.emplace_back(vec(pts[i]).cast<double>(), n.normalized());
+    spread += sample.back().second * sample.back().second.transpose();
+  }
+  if (sample.size() < 10) return std::nullopt;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(spread);  // eigenvalues ascending
+  const Eigen::Vector3d lambda = eig.eigenvalues();
+  if (!(lambda(2) > 0) || lambda(0) > kAcrossAxis * lambda(2) || lambda(1) < kTurning * lambda(2)) return std::nullopt;
+  Cylinder c;
+  c.axis = eig.eigenvectors().col(0);
+  const Eigen::Matrix3d across_axis = Eigen::Matrix3d::Identity() - c.axis * c.axis.transpose();
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const auto& [p, n] : sample) {
+    const Eigen::Vector3d m = (across_axis * n).normalized();
+    const Eigen::Matrix3d off_line = across_axis - m * m.transpose();  // in the plane across the axis, off the line
+    a += off_line;
+    b += off_line * p;
+  }
+  a += c.axis * c.axis.transpose();  // the centre's position along the axis: pinned at 0 (b has no part there)
+  c.point = a.ldlt().solve(b);
+  for (const auto& [p, n] : sample) {
+    const Eigen::Vector3d d = p - c.point;
+    c.radius += (d - d.dot(c.axis) * c.axis).norm();
+  }
+  c.radius /= static_cast<double>(sample.size());
+  if (!std::isfinite(c.radius) || c.radius > kMaxRadius) return std::nullopt;
+  return c;
+}
+
 std::vector<CurvatureLink> curvature_links(const std::vector<Patch>& patches, const std::vector<PatchPair>& linked,
                                            const cv::Mat& assigned_labels, const cv::Mat& points,
                                            const NormalPlanes& normals, const Camera& camera, const Params& params) {

@@ -47,6 +47,7 @@
 #include <limits>
 #include <span>
 
+#include "clutterseg/curvature.hpp"
 #include "clutterseg/occlusion.hpp"
 #include "clutterseg/parallel.hpp"
 #include "clutterseg/support.hpp"
@@ -220,56 +221,6 @@ bool rests_on(const cv::Mat& labels, const cv::Mat& points, int patch, const cv:
     }
   }
   return n >= 10 && below <= n / 20 && 20 * low >= n && height / n > plane_tolerance(band, 1.f);
-}
-
-// A cylinder through a curved face: its axis is the direction its normals are all across (the least
-// eigenvector of sum n n^T), its centre line where the normal lines meet in the plane across it (least
-// squares), its radius the mean distance of the points to that line.
-struct Cylinder {
-  Eigen::Vector3d point, axis;
-  double radius = 0;
-  double distance(const Eigen::Vector3d& x) const {  // from the surface
-    const Eigen::Vector3d d = x - point;
-    return std::abs((d - d.dot(axis) * axis).norm() - radius);
-  }
-};
-// Normals within ~18 deg of across the axis (sin^2 share of the largest eigenvalue), turning by ~8 deg at least
-// (a plane's do not), radius below kMaxRadius.
-constexpr double kAcrossAxis = 0.1, kTurning = 0.02, kMaxRadius = 0.3;
-std::optional<Cylinder> fit_cylinder(const std::vector<int>& pixels, const cv::Vec3f* pts, const NormalPlanes& normals) {
-  const float *nx = normals[0].ptr<float>(), *ny = normals[1].ptr<float>(), *nz = normals[2].ptr<float>();
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> sample;  // (point, normal)
-  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
-  for (int i : pixels) {
-    const Eigen::Vector3d n(nx[i], ny[i], nz[i]);
-    if (!valid_point(pts[i]) || n.squaredNorm() < 0.5) continue;
-    sample.emplace_back(Eigen::Vector3d(pts[i][0], pts[i][1], pts[i][2]), n.normalized());
-    spread += sample.back().second * sample.back().second.transpose();
-  }
-  if (sample.size() < 10) return std::nullopt;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(spread);  // eigenvalues ascending
-  const Eigen::Vector3d lambda = eig.eigenvalues();
-  if (!(lambda(2) > 0) || lambda(0) > kAcrossAxis * lambda(2) || lambda(1) < kTurning * lambda(2)) return std::nullopt;
-  Cylinder c;
-  c.axis = eig.eigenvectors().col(0);
-  const Eigen::Matrix3d across_axis = Eigen::Matrix3d::Identity() - c.axis * c.axis.transpose();
-  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();
-  for (const auto& [p, n] : sample) {
-    const Eigen::Vector3d m = (across_axis * n).normalized();
-    const Eigen::Matrix3d off_line = across_axis - m * m.transpose();  // in the plane across the axis, off the line
-    a += off_line;
-    b += off_line * p;
-  }
-  a += c.axis * c.axis.transpose();  // the centre's position along the axis: pinned at 0 (b has no part there)
-  c.point = a.ldlt().solve(b);
-  for (const auto& [p, n] : sample) {
-    const Eigen::Vector3d d = p - c.point;
-    c.radius += (d - d.dot(c.axis) * c.axis).norm();
-  }
-  c.radius /= static_cast<double>(sample.size());
-  if (!std::isfinite(c.radius) || c.radius > kMaxRadius) return std::nullopt;
-  return c;
 }
 
 // Plane of `patch` near `bbox`: the window grows until the fit is possible (bounded: whole image).
@@ -460,7 +411,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         for (int y = window.y; y < window.y + window.height; y += stride)
           for (int x = window.x; x < window.x + window.width; x += stride)
             if (lab[y * width + x] == l) face_pixels.push_back(y * width + x);
-        cylinder = fit_cylinder(face_pixels, pts, normals);
+        cylinder = fit_cylinder(face_pixels, points, normals);
       }
       faces_near.push_back({object_of(l), plane, cylinder});
     }

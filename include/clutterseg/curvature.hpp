@@ -1,6 +1,8 @@
 // Paper h): curvature matching of curved patches by their normal histograms.
 #pragma once
 
+#include <optional>
+
 #include "clutterseg/adjacency.hpp"
 #include "clutterseg/normals.hpp"
 
@@ -12,6 +14,23 @@ double histogram_similarity(const std::vector<float>& a, const std::vector<float
 // Convexity of a curved patch from its normal histogram (paper Eq. 4, defined physically: a convex
 // surface's normals turn away from its centre). +1 convex, -1 concave, 0 undecided.
 int convexity(const Patch& patch, const cv::Mat& points, const NormalPlanes& normals, int bins);
+
+// A cylinder through a curved surface: its axis is the direction its normals are all across (the least
+// eigenvector of sum n n^T), its centre line where the normal lines meet in the plane across the axis (least
+// squares), its radius the mean distance of the points to that line.
+struct Cylinder {
+  Eigen::Vector3d point, axis;
+  double radius = 0;
+  double distance(const Eigen::Vector3d& x) const {  // from the surface
+    const Eigen::Vector3d d = x - point;
+    return std::abs((d - d.dot(axis) * axis).norm() - radius);
+  }
+};
+
+// The cylinder through `pixels` (at most ~512 of them read, with their normals), or none: fewer than 10 with a
+// normal, normals not all within ~18 deg of across one direction, normals that barely turn (a plane), or a
+// radius above 30 cm.
+std::optional<Cylinder> fit_cylinder(const std::vector<int>& pixels, const cv::Mat& points, const NormalPlanes& normals);
 
 struct CurvatureLink {
   PatchPair pair;
