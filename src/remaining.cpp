@@ -135,7 +135,7 @@ std::optional<MeanNormal> mean_normal(std::span<const int> pixels, const NormalP
 
 // Convexity (n_s - n_f) . (c_s - c_f) / |c_s - c_f| of a segment against a face's local plane (contact.hpp);
 // NaN when the centroids coincide.
-float convexity(const MeanNormal& segment, const Eigen::Vector3f& face_normal, const Eigen::Vector3f& face_centroid) {
+float convexity_to(const MeanNormal& segment, const Eigen::Vector3f& face_normal, const Eigen::Vector3f& face_centroid) {
   const Eigen::Vector3f d = segment.centroid - face_centroid;
   if (!(d.norm() > 1e-4f)) return std::numeric_limits<float>::quiet_NaN();
   return (segment.normal - face_normal).dot(d) / d.norm();
@@ -518,7 +518,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       Plane plane;
       Eigen::Vector3f centroid;
       return fit_plane_near(assigned_labels, points, f.label, seg.bbox, plane, centroid) &&
-             convexity(*segment_normal(), plane.normal, centroid) < 0.f && !meets(f);
+             convexity_to(*segment_normal(), plane.normal, centroid) < 0.f && !meets(f);
     };
     auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
     // A hidden segment (not tiny): the far part of an object the face cuts in two (co-planarity, f/g), or an
@@ -587,7 +587,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         const FacePlane* best = nullptr;
         float best_convexity = kConvex;
         for (const FacePlane& f : planes) {
-          const float c = f.table ? std::numeric_limits<float>::quiet_NaN() : convexity(*own, f.plane.normal, f.centroid);
+          const float c = f.table ? std::numeric_limits<float>::quiet_NaN() : convexity_to(*own, f.plane.normal, f.centroid);
           if (c > best_convexity) { best_convexity = c; best = &f; }
         }
         if (best) {

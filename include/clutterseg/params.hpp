@@ -194,8 +194,8 @@ struct Params {
                                  // plane of a flat face of another object near it joins that object, the
                                  // far part of an object the occluder cuts in two [m at 1 m, times z^2
                                  // beyond]; 0 = off (a new object, as occluded_jump alone)
-    bool hidden_curved = true;   // beyond the paper: ... or on the sphere or cylinder through such a face's pixels
-                                 // near it (their normals' centre of curvature; curvature's occluded cue for a
+    bool hidden_curved = true;   // beyond the paper: ... or on the cylinder through such a face's pixels near it
+                                 // (fit_cylinder, curvature.hpp; the paper's occluded-curvature cue h for a
                                  // segment: a lying cylinder's far part); false = planes only
   } remaining;
 
