@@ -72,11 +72,14 @@ struct Segment {
 // States of a pixel: no patch and no depth (the growing crosses it), a patch pixel, still to grow, grown into
 // a segment, in the segment being looked at; plus a bit for the ring pixels of that segment.
 constexpr uchar kNoDepth = 0, kFace = 1, kRemaining = 2, kGrown = 3, kInSegment = 4, kInRing = 0x80;
+// A remaining pixel on the table's plane (Params::Remaining::apart_on_table), grown only from a pixel clear of the
+// table or from another such pixel.
+constexpr uchar kRemainingOnTable = 5;
 
 // The first pixel at or after `from` still to grow (state.size() if none). memchr: the remaining pixels
 // are few and scattered, and it scans many bytes per step.
-int next_remaining(const std::vector<uchar>& state, int from) {
-  const auto* found = static_cast<const uchar*>(std::memchr(state.data() + from, kRemaining, state.size() - static_cast<size_t>(from)));
+int next_remaining(const std::vector<uchar>& state, int from, uchar which = kRemaining) {
+  const auto* found = static_cast<const uchar*>(std::memchr(state.data() + from, which, state.size() - static_cast<size_t>(from)));
   return static_cast<int>(found ? found - state.data() : static_cast<std::ptrdiff_t>(state.size()));
 }
 
@@ -305,14 +308,31 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   const int reach = 1 + std::max(0, gap_px);  // steps along a direction: the neighbour, then across the gap
   std::vector<float> limit2(static_cast<size_t>(reach) + 1);  // grow_distance per pixel step
   for (int s = 1; s <= reach; ++s) limit2[static_cast<size_t>(s)] = grow2 * static_cast<float>(s * s);
-  for (int seed_px = next_remaining(state, 0); seed_px < total; seed_px = next_remaining(state, seed_px + 1)) {
+  // Beyond the paper: the remaining pixels on the table's plane are grown from the others but never grow into them,
+  // then the rest among themselves: the table's edge band between two objects' feet does not join the two.
+  std::vector<uchar> grown_on_table;  // per entry of `pixels`: it was on the table's plane
+  const bool apart_on_table = table && params.apart_on_table;
+  if (apart_on_table) {
+    grown_on_table.reserve(num_remaining);
+    for (int i = 0; i < total; ++i)
+      if (state[static_cast<size_t>(i)] == kRemaining &&
+          std::abs(table->plane.distance({pts[i][0], pts[i][1], pts[i][2]})) <= plane_tolerance(table->pixel_band, pts[i][2]))
+        state[static_cast<size_t>(i)] = kRemainingOnTable;
+  }
+  const auto grow = [&](int pixel) {
+    if (apart_on_table) grown_on_table.push_back(state[static_cast<size_t>(pixel)] == kRemainingOnTable);
+    state[static_cast<size_t>(pixel)] = kGrown;
+    pixels.push_back(pixel);
+  };
+  for (const uchar seeds : {kRemaining, kRemainingOnTable})
+  for (int seed_px = next_remaining(state, 0, seeds); seed_px < total; seed_px = next_remaining(state, seed_px + 1, seeds)) {
     const size_t begin = pixels.size();
-    pixels.push_back(seed_px);
-    state[static_cast<size_t>(seed_px)] = kGrown;
+    grow(seed_px);
     int x0 = width, y0 = height, x1 = -1, y1 = -1;
     for (size_t head = begin; head < pixels.size(); ++head) {  // every pixel enters once: bounded
       const int i = pixels[head];
       const int x = i % width, y = i / width;
+      const bool from_table = apart_on_table && grown_on_table[head];
       x0 = std::min(x0, x); x1 = std::max(x1, x); y0 = std::min(y0, y); y1 = std::max(y1, y);
       // Along each of the 8 directions: the neighbour, and beyond it while the pixels passed have no depth
       // (at most gap_px of them). Pixels `reach` steps inside the image need no border test (most of them).
@@ -324,12 +344,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
             if (xx < 0 || yy < 0 || xx >= width || yy >= height) break;
           }
           const uchar here = state[static_cast<size_t>(j)];
-          if (here == kRemaining) {
-            if (distance2(pts[i], pts[j]) < limit2[static_cast<size_t>(s)]) {
-              state[static_cast<size_t>(j)] = kGrown;
-              pixels.push_back(j);
-            }
-          }
+          if ((here == kRemaining && !from_table) || here == kRemainingOnTable)
+            if (distance2(pts[i], pts[j]) < limit2[static_cast<size_t>(s)]) grow(j);
           if (here != kNoDepth) break;  // only pixels without depth (and no patch) are crossed
         }
     }

@@ -336,6 +336,31 @@ TEST(Remaining, AFaceRestingOnATopTakesNothingBelowIt) {
   EXPECT_EQ(off.at<int>(25, 30), 2);  // the paper's plane fit: the can's plane holds it
 }
 
+// Beyond the paper (Params::Remaining::apart_on_table): two things without patches whose feet meet the table, with
+// the table's edge band between them left to stage j) too, are two objects: the growing passes from a thing onto
+// the table's plane, never from the table's plane onto a thing. With the paper's growing they are one.
+TEST(Remaining, TwoThingsJoinedOnlyThroughTheTableBandAreTwoObjects) {
+  const auto run = [](bool apart_on_table) {
+    Case c;
+    c.depth.setTo(0);
+    c.labels(cv::Rect(0, 0, 40, 4)).setTo(1);  // the table's patch, away from them (no face of theirs)
+    c.depth(cv::Rect(0, 0, 40, 4)).setTo(1.008f);
+    for (int x = 6; x < 34; ++x) {  // on the table's plane (z = 1.008) from x = 12 to 25, rising 4 mm per pixel beyond
+      const int rise = x < 14 ? 13 - x : (x > 23 ? x - 24 : -1);
+      c.depth(cv::Rect(x, 8, 1, 10)).setTo(1.008f - 0.004f * static_cast<float>(std::max(rise, 0)));
+    }
+    const TableHint table{Plane{Eigen::Vector3f(0, 0, -1), 1.008f}, {1}, 0.005};
+    Params::Remaining params;
+    params.apart_on_table = apart_on_table;
+    return assign_remaining(c.labels, {0}, 1, c.points(), NormalPlanes{}, params, 20, table);
+  };
+  const cv::Mat apart = run(true), paper = run(false);
+  EXPECT_GT(apart.at<int>(12, 7), 1);
+  EXPECT_GT(apart.at<int>(12, 32), 1);
+  EXPECT_NE(apart.at<int>(12, 7), apart.at<int>(12, 32));
+  EXPECT_EQ(paper.at<int>(12, 7), paper.at<int>(12, 32));
+}
+
 TEST(Remaining, GrowingSeparatesDepthJumps) {
   // Two blobs touching in the image, 5 cm apart in depth, with no neighbouring face: two objects.
   Case c;

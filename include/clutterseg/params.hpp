@@ -194,6 +194,9 @@ struct Params {
                                  // plane of a flat face of another object near it joins that object, the
                                  // far part of an object the occluder cuts in two [m at 1 m, times z^2
                                  // beyond]; 0 = off (a new object, as occluded_jump alone)
+    bool apart_on_table = true;  // beyond the paper: the growing never passes from a pixel on the table's plane
+                                 // (TableHint::pixel_band) to one clear of it, so the unassigned table band between
+                                 // two objects' feet joins neither to the other; false = the paper's growing
     bool hidden_curved = true;   // beyond the paper: ... or on the cylinder through such a face's pixels near it
                                  // (fit_cylinder, curvature.hpp; the paper's occluded-curvature cue h for a
                                  // segment: a lying cylinder's far part); false = planes only
