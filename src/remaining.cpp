@@ -314,9 +314,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   const bool apart_on_table = table && params.apart_on_table;
   if (apart_on_table) {
     grown_on_table.reserve(num_remaining);
-    for (int i = 0; i < total; ++i)
-      if (state[static_cast<size_t>(i)] == kRemaining &&
-          std::abs(table->plane.distance({pts[i][0], pts[i][1], pts[i][2]})) <= plane_tolerance(table->pixel_band, pts[i][2]))
+    for (int i = next_remaining(state, 0); i < total; i = next_remaining(state, i + 1))
+      if (std::abs(table->plane.distance({pts[i][0], pts[i][1], pts[i][2]})) <= plane_tolerance(table->pixel_band, pts[i][2]))
         state[static_cast<size_t>(i)] = kRemainingOnTable;
   }
   const auto grow = [&](int pixel) {
