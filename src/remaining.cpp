@@ -14,6 +14,8 @@
 // - Beyond the paper: a segment grows across runs of up to Params::Remaining::gap_px pixels without depth
 //   (a Kinect drops pixels all over a face seen at a grazing angle, which would leave it in specks, each
 //   "tiny" and "without a face"), with grow_distance per pixel step: never across a depth jump.
+// - Beyond the paper: a pixel on the table's plane is grown from a pixel clear of it, never into one
+//   (Params::Remaining::apart_on_table): the table's edge band between two things' feet does not join them.
 // - Beyond the paper: in rule 5 a segment that is a face of its own (its mean normal more than 30 deg from
 //   every neighbouring face's local plane: the narrow side of a box seen edge-on) joins, whole, the face it
 //   meets in a convex edge (n_s - n_f) . (c_s - c_f) > 0, as faces of one object meet, not the table or
