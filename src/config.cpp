@@ -25,7 +25,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Coplanarity, enabled, an
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Curvature, enabled, theta_h, open_objects, occluded, line_fit, neighbour_gap_px, concentric,
                                                 open_centre, split_inside, inside_crease)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::GraphCut, theta_c)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Remaining, grow_distance, gap_px, tiny_px, min_contact_share, hole_px, shadow_baseline, occluded_jump, in_front, below_tops, apart_on_table, hidden_curved,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Remaining, grow_distance, gap_px, tiny_px, min_contact_share, hole_px, shadow_baseline, occluded_jump, in_front, below_tops, apart_on_table, hidden_pairs, hidden_curved,
                                                 hidden_coplanar_band, speck_band)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Support, enabled, objects_only, plane_band, pixel_band, table_angle_deg, max_height, contact_distance, region_margin, wall_min_extent, wall_hides_share, curved_bins_ratio, glued_share, enclosed_share)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Params::Tracking, enabled, max_missed, max_step, merge_share, max_id)

@@ -36,6 +36,9 @@
 // - Beyond the paper: in rules 1-3 a segment that would be an object of its own (hidden behind its one face,
 //   or cut off from every face by missing depth) joins the object on whose nearby faces' planes it lies, with
 //   only nearer things between (the co-planarity cue f/g for a segment; Params::Remaining::hidden_coplanar_band).
+// - Beyond the paper: two segments that became objects of their own behind one occluder (above), on either side of
+//   it with only nearer things between them and on one plane or cylinder, are one object (Params::Remaining::
+//   hidden_pairs): a small box behind an upright bar, seen on both sides of it, with no patch on either part.
 // - Rule 5 is otherwise decided per pixel, not per segment: the remaining pixels between two objects are mostly
 //   a bold edge band that belongs half to each, and boundaries decide the metrics. The plane of each
 //   neighbouring face is a least-squares fit to that face's pixels near the segment (local, so a
@@ -65,6 +68,10 @@ constexpr int kHiddenRatio = 4;
 // at most this many faces near it are fitted.
 constexpr double kCoplanarShare = 0.8;
 constexpr size_t kCoplanarCandidates = 6;
+// Two hidden parts of one object (Params::Remaining::hidden_pairs): the line between their centroids passes
+// behind nearer things for at least this share of its samples; pairs are looked at among at most this many parts.
+constexpr double kPairHiddenShare = 0.25;
+constexpr size_t kMaxHiddenPairs = 64;
 
 struct Segment {
   size_t begin, end;  // its pixels in the list of all segments' pixels
@@ -455,6 +462,12 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     }
     return best_object;
   };
+  // Segments made objects of their own behind an occluder (0: cut off by missing depth), with no far part found.
+  struct HiddenAlone {
+    size_t segment;
+    int occluder, object;
+  };
+  std::vector<HiddenAlone> hidden_alone;
   for (size_t s = 0; s < segments.size(); ++s) {
     const Segment& seg = segments[s];
     const std::span<const int> seg_pixels(pixels.data() + seg.begin, seg.end - seg.begin);
@@ -542,7 +555,9 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     // object of its own.
     const auto hidden_object = [&](const Face& occluder) {
       const int coplanar = params.hidden_coplanar_band > 0 ? coplanar_object(seg_pixels, seg.bbox, object_of(occluder.label)) : 0;
-      return coplanar > 0 ? coplanar : ++next_object;
+      if (coplanar > 0) return coplanar;
+      hidden_alone.push_back({s, object_of(occluder.label), next_object + 1});
+      return ++next_object;
     };
 
     if (faces.empty()) {                                              // rule 1
@@ -550,6 +565,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       // Beyond the paper: cut off by missing depth (an occluder's shadow), it may be the far part of an object.
       if (static_cast<int>(seg_pixels.size()) >= tiny_px) {
         const int coplanar = params.hidden_coplanar_band > 0 ? coplanar_object(seg_pixels, seg.bbox, 0) : 0;
+        if (coplanar == 0) hidden_alone.push_back({s, 0, next_object + 1});
         set_all(coplanar > 0 ? coplanar : ++next_object);
       }
       continue;
@@ -640,6 +656,62 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         if (d < best && !(clear && planes[f].table) && !under_its_top(f, q)) { best = d; obj[i] = planes[f].object_id; }
       }
     }
+  }
+  // Beyond the paper (Params::Remaining::hidden_pairs): two such segments on either side of one occluder, with only
+  // nearer things between them and one surface through both (a plane or a cylinder, hidden_coplanar_band), are the
+  // two visible parts of one object.
+  if (params.hidden_pairs && occlusion && params.hidden_coplanar_band > 0 && hidden_alone.size() >= 2 &&
+      hidden_alone.size() <= kMaxHiddenPairs) {
+    std::vector<int> root(hidden_alone.size());
+    for (size_t a = 0; a < root.size(); ++a) root[a] = static_cast<int>(a);
+    const auto find = [&](int a) { while (root[static_cast<size_t>(a)] != a) a = root[static_cast<size_t>(a)]; return a; };
+    std::vector<std::optional<Eigen::Vector3f>> centroids(hidden_alone.size());  // computed when first asked for
+    const auto centroid_of = [&](size_t h) {
+      if (!centroids[h]) {
+        const Segment& seg = segments[hidden_alone[h].segment];
+        Eigen::Vector3f c = Eigen::Vector3f::Zero();
+        for (size_t k = seg.begin; k < seg.end; ++k) c += Eigen::Vector3f(pts[pixels[k]][0], pts[pixels[k]][1], pts[pixels[k]][2]);
+        centroids[h] = c / static_cast<float>(seg.end - seg.begin);
+      }
+      return *centroids[h];
+    };
+    std::vector<int> both;
+    for (size_t a = 0; a < hidden_alone.size(); ++a)
+      for (size_t b = a + 1; b < hidden_alone.size(); ++b) {
+        const HiddenAlone &ha = hidden_alone[a], &hb = hidden_alone[b];
+        if (ha.occluder != hb.occluder && ha.occluder != 0 && hb.occluder != 0) continue;
+        const Segment &sa = segments[ha.segment], &sb = segments[hb.segment];
+        const int reach = 2 * std::max({sa.bbox.width, sa.bbox.height, sb.bbox.width, sb.bbox.height});  // as coplanar_object
+        if ((grown(sa.bbox, reach, assigned_labels) & sb.bbox).area() == 0) continue;
+        const GapView gap = view_gap(centroid_of(a), centroid_of(b), points, occlusion->camera, occlusion->tolerance);
+        if (gap.behind > occlusion->max_fraction || gap.in_front < kPairHiddenShare) continue;
+        both.assign(pixels.begin() + static_cast<std::ptrdiff_t>(sa.begin), pixels.begin() + static_cast<std::ptrdiff_t>(sa.end));
+        both.insert(both.end(), pixels.begin() + static_cast<std::ptrdiff_t>(sb.begin), pixels.begin() + static_cast<std::ptrdiff_t>(sb.end));
+        const auto share_on = [&](auto&& distance) {
+          int on = 0;
+          for (int i : both) on += distance(Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2])) <= plane_tolerance(params.hidden_coplanar_band, pts[i][2]);
+          return static_cast<double>(on) / static_cast<double>(both.size());
+        };
+        Plane plane;
+        bool one_surface = fit_plane(both, points, plane) &&
+                           share_on([&](const Eigen::Vector3f& q) { return std::abs(plane.distance(q)); }) >= kCoplanarShare;
+        if (!one_surface && params.hidden_curved && have_normals)
+          if (const auto cylinder = fit_cylinder(both, points, normals))
+            one_surface = share_on([&](const Eigen::Vector3f& q) { return static_cast<float>(cylinder->distance(q.cast<double>())); }) >= kCoplanarShare;
+        if (one_surface) root[static_cast<size_t>(find(static_cast<int>(b)))] = find(static_cast<int>(a));
+      }
+    // Relabel the joined parts with their first part's object, and number the new objects 1.. again without gaps.
+    std::vector<int> renamed(static_cast<size_t>(next_object) + 1);
+    for (int o = 0; o <= next_object; ++o) renamed[static_cast<size_t>(o)] = o;
+    for (size_t a = 0; a < hidden_alone.size(); ++a)
+      renamed[static_cast<size_t>(hidden_alone[a].object)] = hidden_alone[static_cast<size_t>(find(static_cast<int>(a)))].object;
+    int next = num_objects;
+    std::vector<int> compact(static_cast<size_t>(next_object) + 1, 0);
+    for (int o = num_objects + 1; o <= next_object; ++o)
+      if (renamed[static_cast<size_t>(o)] == o) compact[static_cast<size_t>(o)] = ++next;
+    if (next < next_object)  // new objects are only ever given to the segments' pixels
+      for (int i : pixels)
+        if (obj[i] > num_objects) obj[i] = compact[static_cast<size_t>(renamed[static_cast<size_t>(obj[i])])];
   }
   return objects;
 }

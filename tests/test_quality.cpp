@@ -229,15 +229,15 @@ TEST(Quality, BumpsOfNoiseOnARealTableAreNoObjects) {
 
 // The paper's Table II families as `scripts/synth_table2.sh out/table2 20 11` writes them (Kinect v1,
 // 640x480, seed 11, 20 frames each), scored as `clutterseg eval` scores them: docs/RESULTS.md, "Synthetic
-// scenes with exact labels" (boxes 95.8 / 1.6 / 97.3, stacked boxes 91.4 / 4.6 / 93.6, occluded 88.0 / 5.4 /
-// 93.6, cylinders 95.2 / 1.5 / 96.9, mixed 94.8 / 1.6 / 96.5, complex 89.5 / 4.4 / 94.5: tp / fp / Overlap F).
+// scenes with exact labels" (boxes 95.8 / 1.6 / 97.3, stacked boxes 91.4 / 4.6 / 93.6, occluded 88.6 / 5.4 /
+// 93.8, cylinders 95.2 / 1.5 / 96.9, mixed 94.8 / 1.6 / 96.5, complex 89.5 / 4.4 / 94.5: tp / fp / Overlap F).
 // Issue 14's targets where they are met (tp >= 90, fp <= 5), a point of slack elsewhere.
 TEST(Quality, SyntheticTableIIFamilies) {
   struct Family {
     const char* name;
     double min_tp, max_fp;
   };
-  const Family families[] = {{"boxes", 0.90, 0.05},    {"stacked-boxes", 0.90, 0.05}, {"occluded", 0.87, 0.065},
+  const Family families[] = {{"boxes", 0.90, 0.05},    {"stacked-boxes", 0.90, 0.05}, {"occluded", 0.875, 0.065},
                              {"cylinders", 0.90, 0.05}, {"mixed", 0.90, 0.05},         {"complex", 0.88, 0.05}};
   const Camera camera = synth::default_camera();
   Params p;

@@ -250,6 +250,36 @@ TEST(Remaining, AHiddenSegmentOnTheFarPartsPlaneJoinsItAcrossTheOccluder) {
   }
 }
 
+// Beyond the paper (Params::Remaining::hidden_pairs; occluded-000015: a small box behind an upright bar, seen on
+// both sides of it, neither part a patch): two remaining segments hidden behind one occluder, with only the
+// occluder between them, on one plane, are one object; a part 10 cm behind the other's plane, or the switch off,
+// two objects.
+TEST(Remaining, TwoHiddenPartsOnEitherSideOfOneOccluderAreOneObject) {
+  const auto run = [](float right_z, bool pairs) {
+    Case c;
+    c.labels.setTo(1);                          // the occluder, 20 cm in front, all around
+    c.depth.setTo(0.9f);
+    c.labels(cv::Rect(8, 10, 8, 8)).setTo(0);   // the left part
+    c.depth(cv::Rect(8, 10, 8, 8)).setTo(1.1f);
+    c.labels(cv::Rect(24, 10, 8, 8)).setTo(0);  // the right part, the occluder's 8 columns between them
+    c.depth(cv::Rect(24, 10, 8, 8)).setTo(right_z);
+    Params::Remaining params;
+    params.hidden_pairs = pairs;
+    const Params::Coplanarity coplanarity;
+    const OcclusionCheck occlusion{Case::camera(), coplanarity.behind_tolerance, coplanarity.behind_fraction};
+    const cv::Mat o = assign_remaining(c.labels, {0}, 1, c.points(), NormalPlanes{}, params, 20, {}, &occlusion);
+    EXPECT_GT(o.at<int>(14, 11), 1);
+    EXPECT_GT(o.at<int>(14, 27), 1);
+    double largest = 0;
+    cv::minMaxLoc(o, nullptr, &largest);
+    EXPECT_EQ(largest, o.at<int>(14, 11) == o.at<int>(14, 27) ? 2 : 3);  // ids stay 1..M without a gap
+    return o.at<int>(14, 11) == o.at<int>(14, 27);
+  };
+  EXPECT_TRUE(run(1.1f, true));    // on one plane: one object
+  EXPECT_FALSE(run(1.2f, true));   // 10 cm behind it: two
+  EXPECT_FALSE(run(1.1f, false));  // off: two, as before
+}
+
 // The same for a curved far part (Params::Remaining::hidden_curved; occluded-000018: a lying cylinder cut by an
 // upright box, its right part with no patch). The cylinder (radius 3 cm, axis along x, 1.14 m away) shows its
 // whole arc, so its left part lies up to ~1 cm off the right part's plane and the plane test fails; on the

@@ -194,6 +194,10 @@ struct Params {
                                  // plane of a flat face of another object near it joins that object, the
                                  // far part of an object the occluder cuts in two [m at 1 m, times z^2
                                  // beyond]; 0 = off (a new object, as occluded_jump alone)
+    bool hidden_pairs = true;    // beyond the paper: two segments hidden behind one occluder, each an object of its
+                                 // own with no far part found, that lie on either side of it with only nearer things
+                                 // between them and on one plane or cylinder (hidden_coplanar_band) are one object;
+                                 // false = two objects
     bool apart_on_table = true;  // beyond the paper: the growing never passes from a pixel on the table's plane
                                  // (TableHint::pixel_band) to one clear of it, so the unassigned table band between
                                  // two objects' feet joins neither to the other; false = the paper's growing
