@@ -388,6 +388,7 @@ TEST(Remaining, TwoThingsJoinedOnlyThroughTheTableBandAreTwoObjects) {
   EXPECT_GT(apart.at<int>(12, 7), 1);
   EXPECT_GT(apart.at<int>(12, 32), 1);
   EXPECT_NE(apart.at<int>(12, 7), apart.at<int>(12, 32));
+  EXPECT_EQ(apart.at<int>(12, 12), apart.at<int>(12, 7));  // a thing's foot on the table's plane stays with it
   EXPECT_EQ(paper.at<int>(12, 7), paper.at<int>(12, 32));
 }
 
