@@ -193,16 +193,14 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
       visit(yy * width + xx, xx, yy);
     }
   };
-  for (const Carrier& c : carriers) gather(c, std::integral_constant<int, 0>{});
-  for (auto it = carriers.rbegin(); it != carriers.rend(); ++it) gather(*it, std::integral_constant<int, 1>{});
-
-  // The paper's rule on each reached pixel with depth: seeds within d_max.
+  // The paper's rule on each reached pixel with depth: seeds within d_max. A carrier's seeds are final once the
+  // backward pass has gathered them, so the rule runs there, while they are in cache (no third pass).
   int* assigned = out.labels.ptr<int>();
   out.contacts.reserve(carriers.size() / 4);  // pairs for 5-28 % of the carriers on the dev sets: no regrowth
-  for (size_t k = 0; k < carriers.size(); ++k) {
-    const int i = carriers[k].i;
-    if (!valid_point(pts[i])) continue;
-    const SeedSet& own = seeds[k];
+  const auto decide = [&](const Carrier& c) {
+    const int i = c.i;
+    if (!valid_point(pts[i])) return;
+    const SeedSet& own = seeds[static_cast<size_t>(role[static_cast<size_t>(i)])];
     int near[kMaxSeeds], count = 0, best = -1;
     for (int s = 0; s < own.count; ++s) {
       if (own.d2[s] >= d2_max) continue;
@@ -210,7 +208,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
       if (best < 0 || own.d2[s] < own.d2[best] || (own.d2[s] == own.d2[best] && own.label[s] < own.label[best]))
         best = s;
     }
-    if (best < 0) continue;
+    if (best < 0) return;
     assigned[i] = own.label[best];
     for (int a = 0; a < count; ++a)
       for (int b = a + 1; b < count; ++b) {
@@ -219,8 +217,15 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
         const auto pixel = [width](const Seed& s) { return static_cast<int>(s.yx >> 16) * width + static_cast<int>(s.yx & 0xffff); };
         out.contacts.push_back({sa.label - 1, sb.label - 1, pixel(sa), pixel(sb)});
       }
+  };
+  for (const Carrier& c : carriers) gather(c, std::integral_constant<int, 0>{});
+  for (auto it = carriers.rbegin(); it != carriers.rend(); ++it) {
+    gather(*it, std::integral_constant<int, 1>{});
+    decide(*it);
   }
-  // Carriers come in raster order, so a stable sort by pair keeps each pair's contacts in raster order.
+  // The contacts came in reverse raster order: reversed, each pair's come in raster order (one carrier gives a pair
+  // at most once, so the order within a carrier does not matter once they are sorted by pair).
+  std::reverse(out.contacts.begin(), out.contacts.end());
   std::stable_sort(out.contacts.begin(), out.contacts.end(),
                    [](const Contact& x, const Contact& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
   for (const Contact& c : out.contacts)
