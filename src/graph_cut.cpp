@@ -32,14 +32,6 @@ struct DenseCut {
   std::vector<std::vector<int>> cheap_groups;
 };
 
-int find_root(std::vector<int>& parent, int x) {
-  while (parent[static_cast<size_t>(x)] != x) {
-    parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
-    x = parent[static_cast<size_t>(x)];
-  }
-  return x;
-}
-
 // Global minimum cut of a dense symmetric k x k weight matrix (row-major, zero diagonal; consumed).
 //
 // Stoer-Wagner, accelerated by the contraction test of Nagamochi, Ono and Ibaraki: in a maximum-

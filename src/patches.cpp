@@ -89,11 +89,7 @@ CLUTTERSEG_AVX2_KERNEL void normal_bins(const float* __restrict nx, const float*
 // per run instead of a pass over every pixel.
 int label_runs(const cv::Mat& edges, std::vector<LabelRun>& runs) {
   std::vector<int> parent;
-  const auto root = [&](int i) {
-    while (parent[static_cast<size_t>(i)] != i)  // path halving: each step shortens the path
-      i = parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
-    return i;
-  };
+  const auto root = [&](int i) { return find_root(parent, i); };
   const int cols = edges.cols;
   size_t previous_row = 0;  // index of the previous row's first run
   for (int y = 0; y < edges.rows; ++y) {

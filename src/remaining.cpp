@@ -395,6 +395,12 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   // such face (co-planarity's occlusion check, g); 0 if none. The faces looked for are those in the
   // segment's box grown by twice its size on every side (an occluder twice as wide as the segment), read
   // with a stride (at most about kMaxVisits pixels); at most kCoplanarCandidates of them are fitted.
+  // A point on a face's plane or on the cylinder through it, within hidden_coplanar_band (times z^2).
+  const auto on_surface = [&](const cv::Vec3f& q, const Plane& plane, const std::optional<Cylinder>& cylinder) {
+    const double band = plane_tolerance(params.hidden_coplanar_band, q[2]);
+    return std::abs(plane.distance({q[0], q[1], q[2]})) <= band ||
+           (cylinder && cylinder->distance(Eigen::Vector3d(q[0], q[1], q[2])) <= band);
+  };
   std::vector<uchar> on_face;  // per segment pixel: on a face of the object looked at
   std::vector<int> face_pixels;  // a face's pixels in the window, for a cylinder through them
   const auto coplanar_object = [&](std::span<const int> seg_pixels, const cv::Rect& bbox, int occluder) {
@@ -448,14 +454,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       on_face.assign(seg_pixels.size(), 0);
       for (size_t g = f; g < faces_near.size(); ++g) {
         if (faces_near[g].object != object) continue;
-        const Plane& plane = faces_near[g].plane;
-        const std::optional<Cylinder>& cylinder = faces_near[g].cylinder;
-        for (size_t k = 0; k < seg_pixels.size(); ++k) {
-          const cv::Vec3f& q = pts[seg_pixels[k]];
-          const double band = plane_tolerance(params.hidden_coplanar_band, q[2]);
-          on_face[k] |= std::abs(plane.distance({q[0], q[1], q[2]})) <= band ||
-                        (cylinder && cylinder->distance(Eigen::Vector3d(q[0], q[1], q[2])) <= band);
-        }
+        for (size_t k = 0; k < seg_pixels.size(); ++k)
+          on_face[k] |= on_surface(pts[seg_pixels[k]], faces_near[g].plane, faces_near[g].cylinder);
       }
       const double share = static_cast<double>(std::count(on_face.begin(), on_face.end(), 1)) / static_cast<double>(seg_pixels.size());
       if (share > best_share) { best_share = share; best_object = object; }
@@ -664,7 +664,7 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
       hidden_alone.size() <= kMaxHiddenPairs) {
     std::vector<int> root(hidden_alone.size());
     for (size_t a = 0; a < root.size(); ++a) root[a] = static_cast<int>(a);
-    const auto find = [&](int a) { while (root[static_cast<size_t>(a)] != a) a = root[static_cast<size_t>(a)]; return a; };
+    const auto find = [&](int a) { return find_root(root, a); };
     std::vector<std::optional<Eigen::Vector3f>> centroids(hidden_alone.size());  // computed when first asked for
     const auto centroid_of = [&](size_t h) {
       if (!centroids[h]) {
@@ -687,18 +687,12 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
         if (gap.behind > occlusion->max_fraction || gap.in_front < kPairHiddenShare) continue;
         both.assign(pixels.begin() + static_cast<std::ptrdiff_t>(sa.begin), pixels.begin() + static_cast<std::ptrdiff_t>(sa.end));
         both.insert(both.end(), pixels.begin() + static_cast<std::ptrdiff_t>(sb.begin), pixels.begin() + static_cast<std::ptrdiff_t>(sb.end));
-        const auto share_on = [&](auto&& distance) {
-          int on = 0;
-          for (int i : both) on += distance(Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2])) <= plane_tolerance(params.hidden_coplanar_band, pts[i][2]);
-          return static_cast<double>(on) / static_cast<double>(both.size());
-        };
+        // The same test as for a face near a segment (coplanar_object): on the plane or the cylinder through both.
         Plane plane;
-        bool one_surface = fit_plane(both, points, plane) &&
-                           share_on([&](const Eigen::Vector3f& q) { return std::abs(plane.distance(q)); }) >= kCoplanarShare;
-        if (!one_surface && params.hidden_curved && have_normals)
-          if (const auto cylinder = fit_cylinder(both, points, normals))
-            one_surface = share_on([&](const Eigen::Vector3f& q) { return static_cast<float>(cylinder->distance(q.cast<double>())); }) >= kCoplanarShare;
-        if (one_surface) root[static_cast<size_t>(find(static_cast<int>(b)))] = find(static_cast<int>(a));
+        if (!fit_plane(both, points, plane)) continue;
+        const std::optional<Cylinder> cylinder = params.hidden_curved && have_normals ? fit_cylinder(both, points, normals) : std::nullopt;
+        const auto on = std::count_if(both.begin(), both.end(), [&](int i) { return on_surface(pts[i], plane, cylinder); });
+        if (static_cast<double>(on) >= kCoplanarShare * static_cast<double>(both.size())) root[static_cast<size_t>(find(static_cast<int>(b)))] = find(static_cast<int>(a));
       }
     // Relabel the joined parts with their first part's object, and number the new objects 1.. again without gaps.
     std::vector<int> renamed(static_cast<size_t>(next_object) + 1);

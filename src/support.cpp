@@ -633,10 +633,7 @@ int settle_table(std::vector<Patch>& patches, const std::vector<std::pair<int, i
   // Groups of table patches adjacent to each other (union-find, path halving).
   std::vector<int> parent(static_cast<size_t>(n));
   std::iota(parent.begin(), parent.end(), 0);
-  const auto root = [&](int v) {
-    while (parent[static_cast<size_t>(v)] != v) v = parent[static_cast<size_t>(v)] = parent[static_cast<size_t>(parent[static_cast<size_t>(v)])];
-    return v;
-  };
+  const auto root = [&](int v) { return find_root(parent, v); };
   const auto table = [&](int p) { return patches[static_cast<size_t>(p)].table; };
   for (const auto& [a, b] : adjacent)
     if (table(a) && table(b)) parent[static_cast<size_t>(root(a))] = root(b);

@@ -118,6 +118,13 @@ inline int first_zero(const std::uint8_t* bytes, int from, int end) {
   return from;
 }
 
+// The root of x's set in a union-find forest (`parent[i] == i` for a root), halving the path on the way: every
+// union-find of the library (patch runs, the graph cut, table groups, hidden parts) uses this one.
+inline int find_root(std::vector<int>& parent, int x) {
+  while (parent[static_cast<size_t>(x)] != x) x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
+  return x;
+}
+
 // The most pixels a per-patch statistic reads (a RANSAC sample, a share, a fit): `vga` in a 640x480 frame,
 // and in a smaller frame that many times its share of VGA's pixels (a quarter at 320x240, never less), so
 // that every frame samples the scene as densely and a smaller frame spends proportionally less per patch,
