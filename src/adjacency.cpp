@@ -29,8 +29,11 @@ namespace clutterseg {
 
 namespace {
 
-// Seeds kept per pixel: one per patch, the nearest kMaxSeeds patches.
-constexpr int kMaxSeeds = 4;
+// Seeds kept per pixel: one per patch, the nearest kMaxSeeds patches. Two: an edge pixel lies where two
+// surfaces meet. At a corner a third patch within d_max is heard by the pixels along its own borders with
+// each of the two; four seeds gave the same pairs and scores on every set (docs/ADJACENCY.md, "Two seeds")
+// in sets twice as large, and the sets' size is what the passes pay for.
+constexpr int kMaxSeeds = 2;
 
 // A seed is a patch pixel, named by its image position and carrying its label; its 3D point is read
 // from the cloud when a distance is needed (it lies within r pixels, so in cache).
@@ -47,9 +50,9 @@ std::uint32_t pack(int x, int y) { return static_cast<std::uint32_t>(y) << 16 | 
 constexpr std::uint32_t kNoSeed = 0xffffffffu;
 static_assert(kMaxFrameSide <= 0xffff, "pack() keeps x and y in 16 bits each, below kNoSeed");
 
-// The seeds a pixel holds, stored as arrays (52 bytes; the sets of all carriers of a 640x480 frame take
-// about 2 MB). Most of the work is asking whether a seed is held already: four compares without a
-// branch (empty slots hold kNoSeed), instead of a loop whose exit a CPU cannot predict.
+// The seeds a pixel holds, stored as arrays (28 bytes; the sets of all carriers of a 640x480 frame take
+// about 1.5 MB). Most of the work is asking whether a seed is held already: one compare per slot without
+// a branch (empty slots hold kNoSeed), instead of a loop whose exit a CPU cannot predict.
 struct SeedSet {
   std::uint32_t yx[kMaxSeeds];
   int label[kMaxSeeds];
@@ -57,8 +60,8 @@ struct SeedSet {
   int count;
   SeedSet() : count(0) { std::fill(yx, yx + kMaxSeeds, kNoSeed); }
   bool holds(std::uint32_t pixel) const {
-    static_assert(kMaxSeeds == 4, "holds() compares four slots");
-    return (yx[0] == pixel) | (yx[1] == pixel) | (yx[2] == pixel) | (yx[3] == pixel);
+    static_assert(kMaxSeeds == 2, "holds() compares two slots");
+    return (yx[0] == pixel) | (yx[1] == pixel);
   }
   Seed at(int i) const { return {yx[i], label[i], d2[i]}; }
   void put(int i, const Seed& s) { yx[i] = s.yx; label[i] = s.label; d2[i] = s.d2; }
