@@ -58,7 +58,10 @@ struct SeedSet {
   int label[kMaxSeeds];
   float d2[kMaxSeeds];
   int count;
-  SeedSet() : count(0) { std::fill(yx, yx + kMaxSeeds, kNoSeed); }
+  void clear() {
+    std::fill(yx, yx + kMaxSeeds, kNoSeed);
+    count = 0;
+  }
   bool holds(std::uint32_t pixel) const {
     static_assert(kMaxSeeds == 2, "holds() compares two slots");
     return (yx[0] == pixel) | (yx[1] == pixel);
@@ -151,7 +154,9 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     role[static_cast<size_t>(i)] = static_cast<int>(carriers.size());
     carriers.push_back({i, static_cast<std::int16_t>(i % width), static_cast<std::int16_t>(i / width)});
   }
-  std::vector<SeedSet> seeds(carriers.size());
+  // Each set is cleared when the forward pass reaches its carrier: every set that pass reads (W, N, NE) belongs
+  // to a carrier before it in raster order, so no pass over all of them first.
+  const auto seeds = std::make_unique_for_overwrite<SeedSet[]>(carriers.size());
 
   // Two raster passes (forward: from W, N, NE; backward: from E, S, SW), as in a chamfer distance
   // transform: a seed reaches every pixel within r along a path the passes follow. NW and SE are left
@@ -165,6 +170,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     constexpr auto& from = kFrom[decltype(pass)::value];
     const int x = c.x, y = c.y;
     SeedSet& own = seeds[static_cast<size_t>(role[static_cast<size_t>(c.i)])];
+    if constexpr (decltype(pass)::value == 0) own.clear();
     const cv::Vec3f here = pts[c.i];
     const bool has_point = valid_point(here);
     auto offer = [&](std::uint32_t yx, int label) {
