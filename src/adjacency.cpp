@@ -19,7 +19,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <opencv2/imgproc.hpp>
 #include <type_traits>
 
 #include "clutterseg/limits.hpp"
@@ -96,23 +95,31 @@ struct SeedSet {
 };
 
 // 255 where the point (interleaved xyz) has depth, else 0.
-CLUTTERSEG_ROW_KERNEL void mark_depth(const float* __restrict xyz, int total, uchar* __restrict out) {
-  for (int i = 0; i < total; ++i) out[i] = valid_depth(xyz[3 * i + 2]) ? 255 : 0;
+CLUTTERSEG_ROW_KERNEL void mark_depth(const float* __restrict xyz, int count, uchar* __restrict out) {
+  for (int i = 0; i < count; ++i) out[i] = valid_depth(xyz[3 * i + 2]) ? 255 : 0;
+}
+
+// near[x] = 255 where a pixel of the 3x3 block around x has depth: rows up, mid, down of the depth mask,
+// padded by one 0 at both ends (index x + 1 is pixel x).
+CLUTTERSEG_ROW_KERNEL void mark_near_depth(const uchar* __restrict up, const uchar* __restrict mid,
+                                          const uchar* __restrict down, int cols, uchar* __restrict near) {
+  for (int x = 0; x < cols; ++x)
+    near[x] = up[x] | up[x + 1] | up[x + 2] | mid[x] | mid[x + 1] | mid[x + 2] | down[x] | down[x + 1] | down[x + 2];
 }
 
 // role = source where the pixel is a patch pixel with depth, else neither; carrier = 1 where it is no
 // patch pixel but has depth within one pixel (branch-free, one vectorised pass). Returns the carriers' count.
 CLUTTERSEG_ROW_KERNEL int mark_roles(const int* __restrict labels, const uchar* __restrict has_depth,
-                                     const uchar* __restrict near_depth, int total, int num_patches, int source,
+                                     const uchar* __restrict near_depth, int count, int num_patches, int source,
                                      int neither, int* __restrict role, uchar* __restrict carrier) {
-  int count = 0;
-  for (int i = 0; i < total; ++i) {
+  int carriers = 0;
+  for (int i = 0; i < count; ++i) {
     const int l = labels[i];
     role[i] = ((l > 0) & (l <= num_patches) & (has_depth[i] != 0)) ? source : neither;
     carrier[i] = (l == 0) & (near_depth[i] != 0);
-    count += carrier[i];
+    carriers += carrier[i];
   }
-  return count;
+  return carriers;
 }
 
 }  // namespace
@@ -136,23 +143,36 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   // pixels with depth and the pixels without depth next to one (seeds cross holes of 1-2 px inside an
   // edge band, but do not flood the large regions without depth).
   constexpr int kSource = -2, kNeither = -1;
-  cv::Mat has_depth(patch_labels.size(), CV_8U), near_depth;
-  mark_depth(&pts[0][0], total, has_depth.ptr<uchar>());
-  cv::dilate(has_depth, near_depth, cv::Mat());
-  // Every element is written by mark_roles: no zeroing (1.5 MB per 640x480 frame).
+  // Every element of `role` is written row by row below: no zeroing (1.2 MB per 640x480 frame).
   const auto role = std::make_unique_for_overwrite<int[]>(static_cast<size_t>(total));
-  const auto carrier = std::make_unique_for_overwrite<uchar[]>(static_cast<size_t>(total));
-  const int num_carriers = mark_roles(lab, has_depth.ptr<uchar>(), near_depth.ptr<uchar>(), total, num_patches, kSource,
-                                      kNeither, role.get(), carrier.get());
   struct Carrier {
     int i;
     std::int16_t x, y;
   };
   std::vector<Carrier> carriers;
-  carriers.reserve(static_cast<size_t>(num_carriers));
-  for (int i = first_nonzero(carrier.get(), 0, total); i < total; i = first_nonzero(carrier.get(), i + 1, total)) {
-    role[static_cast<size_t>(i)] = static_cast<int>(carriers.size());
-    carriers.push_back({i, static_cast<std::int16_t>(i % width), static_cast<std::int16_t>(i / width)});
+  carriers.reserve(static_cast<size_t>(total) / 4);  // 8-20 % of the pixels on the dev sets
+  // Row by row: the depth mask of rows y - 1, y, y + 1 (zero-padded: outside the image has no depth), the
+  // 3x3 "depth nearby" of row y, then its roles and carriers, in one sweep over the frame.
+  const int padded = width + 2;
+  std::vector<uchar> depth_rows(3 * static_cast<size_t>(padded), 0), near(static_cast<size_t>(width)),
+      carrier(static_cast<size_t>(width));
+  uchar* up = depth_rows.data();
+  uchar* mid = up + padded;
+  uchar* down = mid + padded;
+  mark_depth(&pts[0][0], width, mid + 1);
+  for (int y = 0; y < height; ++y) {
+    if (y + 1 < height) mark_depth(&pts[(y + 1) * width][0], width, down + 1);
+    else std::fill(down, down + padded, uchar{0});
+    mark_near_depth(up, mid, down, width, near.data());
+    const int row = y * width;
+    if (mark_roles(lab + row, mid + 1, near.data(), width, num_patches, kSource, kNeither, role.get() + row,
+                   carrier.data()) > 0)
+      for (int x = first_nonzero(carrier.data(), 0, width); x < width; x = first_nonzero(carrier.data(), x + 1, width)) {
+        role[static_cast<size_t>(row + x)] = static_cast<int>(carriers.size());
+        carriers.push_back({row + x, static_cast<std::int16_t>(x), static_cast<std::int16_t>(y)});
+      }
+    std::swap(up, mid);  // the rows move up by one: mid becomes up, down becomes mid
+    std::swap(mid, down);
   }
   // Each set is cleared when the forward pass reaches its carrier: every set that pass reads (W, N, NE) belongs
   // to a carrier before it in raster order, so no pass over all of them first.
