@@ -225,6 +225,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
   // The paper's rule on each reached pixel with depth: seeds within d_max. A carrier's seeds are final once the
   // backward pass has gathered them, so the rule runs there, while they are in cache (no third pass).
   int* assigned = out.labels.ptr<int>();
+  out.assigned.reserve(carriers.size());
   out.contacts.reserve(carriers.size() / 4);  // pairs for 5-28 % of the carriers on the dev sets: no regrowth
   const auto decide = [&](const Carrier& c) {
     const int i = c.i;
@@ -239,6 +240,7 @@ Assignment assign_edge_pixels(const cv::Mat& patch_labels, const cv::Mat& points
     }
     if (best < 0) return;
     assigned[i] = own.label[best];
+    out.assigned.push_back(i);
     for (int a = 0; a < count; ++a)
       for (int b = a + 1; b < count; ++b) {
         Seed sa = own.at(near[a]), sb = own.at(near[b]);

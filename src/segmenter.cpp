@@ -151,7 +151,7 @@ Result Segmenter::segment(const cv::Mat& depth_in, const Camera& camera) {
   for (int round = 0; round < 2; ++round) {  // again once a patch two objects share is split (beyond the paper)
     assignment = assign_edge_pixels(r.core_patch_labels, r.points, static_cast<int>(r.patches.size()),  // d) adjacency
                                     px.length(p.adjacency.radius_px), p.adjacency.d_max);
-    if (table) release_from_table(assignment.labels, r.core_patch_labels, r.patches, r.points, *table, p.support);
+    if (table) release_from_table(assignment.labels, assignment.assigned, r.patches, r.points, *table, p.support);
     adjacent = without_table_links(assignment.adjacent, r.patches);
     watch.mark("assignment");
     links = p.cutfree.enabled ? cut_free_pairs(adjacent, r.patches, r.points, p.cutfree, p.seed) : adjacent;  // e) cut-free

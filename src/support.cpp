@@ -589,33 +589,19 @@ int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv:
   return cut;
 }
 
-namespace {
-
-// differs[i] = 1 where a[i] != b[i].
-CLUTTERSEG_ROW_KERNEL void mark_differing(const int* __restrict a, const int* __restrict b, int n,
-                                          std::uint8_t* __restrict differs) {
-  for (int i = 0; i < n; ++i) differs[i] = a[i] != b[i];
-}
-
-}  // namespace
-
-int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, const std::vector<Patch>& patches,
+int release_from_table(cv::Mat& assigned_labels, const std::vector<int>& edge_pixels, const std::vector<Patch>& patches,
                        const cv::Mat& points, const Plane& plane, const Params::Support& params) {
   const auto* pts = points.ptr<cv::Vec3f>();
-  const int* core = core_labels.ptr<int>();
   int* lab = assigned_labels.ptr<int>();
   const int total = static_cast<int>(assigned_labels.total()), num_patches = static_cast<int>(patches.size());
   const float a = plane.normal.x(), b = plane.normal.y(), c = plane.normal.z(), d = plane.offset;
   const auto k = static_cast<float>(params.pixel_band);
   std::vector<std::uint8_t> table(static_cast<size_t>(num_patches) + 1, 0);
   for (int p = 0; p < num_patches; ++p) table[static_cast<size_t>(p) + 1] = patches[static_cast<size_t>(p)].table;
-  // Only edge pixels can be released: those whose label differs from the core label, marked in a
-  // vectorised pass and then visited eight bytes at a time.
-  cv::Mat differs_image(assigned_labels.size(), CV_8U);  // every byte written: no zeroing
-  std::uint8_t* differs = differs_image.ptr<std::uint8_t>();
-  mark_differing(lab, core, total, differs);
+  // Only edge pixels can be released, and step d) lists the ones it labelled.
   int released = 0;
-  for (int i = first_nonzero(differs, 0, total); i < total; i = first_nonzero(differs, i + 1, total)) {
+  for (const int i : edge_pixels) {
+    if (i < 0 || i >= total) throw Error("release_from_table: edge pixel out of range");
     const int l = lab[i];
     if (l <= 0 || l > num_patches) continue;  // no patch
     const float x = pts[i][0], y = pts[i][1], z = pts[i][2];

@@ -19,6 +19,7 @@ struct Assignment {
   cv::Mat labels;                  // CV_32S: patch id (1..N) per pixel, edge pixels included; 0 = none
   std::vector<PatchPair> adjacent; // every pair of patches seen together by one edge pixel; sorted, unique
   std::vector<Contact> contacts;   // one per edge pixel and pair it saw, sorted by pair (then edge pixel)
+  std::vector<int> assigned;       // the edge pixels given a patch here (linear indices, any order)
 };
 
 // For every edge pixel with a valid point: the patch pixels within `radius_px` in the image whose 3D

@@ -112,8 +112,8 @@ int split_at_planes(cv::Mat& edges, const std::vector<Patch>& patches, const cv:
 
 // Edge pixels that step d) gave to a table patch but that stand more than pixel_band clear of the plane
 // (the foot of a box face, the lower half of a lying marker): unassigned again (0), for stage j) to give to
-// the object they belong to. Returns how many.
-int release_from_table(cv::Mat& assigned_labels, const cv::Mat& core_labels, const std::vector<Patch>& patches,
+// the object they belong to. `edge_pixels`: the pixels step d) labelled (Assignment::assigned). Returns how many.
+int release_from_table(cv::Mat& assigned_labels, const std::vector<int>& edge_pixels, const std::vector<Patch>& patches,
                        const cv::Mat& points, const Plane& plane, const Params::Support& params);
 
 // After the graph cut, the table is one object: the group of table patches that holds the largest one,
