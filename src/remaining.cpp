@@ -50,7 +50,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <memory>
 #include <span>
 
 #include "clutterseg/curvature.hpp"
@@ -88,7 +87,7 @@ constexpr uchar kRemainingOnTable = 5;
 
 // The first pixel at or after `from` still to grow (state.size() if none). memchr: the remaining pixels
 // are few and scattered, and it scans many bytes per step.
-int next_remaining(std::span<const uchar> state, int from, uchar which = kRemaining) {
+int next_remaining(const std::vector<uchar>& state, int from, uchar which = kRemaining) {
   const auto* found = static_cast<const uchar*>(std::memchr(state.data() + from, which, state.size() - static_cast<size_t>(from)));
   return static_cast<int>(found ? found - state.data() : static_cast<std::ptrdiff_t>(state.size()));
 }
@@ -300,10 +299,8 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   for (int p = 0; p < num_patches; ++p) object_of_label[static_cast<size_t>(p) + 1] = object_of_patch[static_cast<size_t>(p)] + 1;
   cv::Mat objects(assigned_labels.size(), CV_32S);
   int* obj = objects.ptr<int>();
-  // Every pixel's state is marked once (by mark_remaining: no zeroing first), so the growing below reads one
-  // byte per pixel.
-  const auto state_memory = std::make_unique_for_overwrite<uchar[]>(static_cast<size_t>(total));
-  const std::span<uchar> state(state_memory.get(), static_cast<size_t>(total));
+  // Every pixel's state is marked once, so the growing below reads one byte per pixel.
+  std::vector<uchar> state(static_cast<size_t>(total), 0);
   int max_label = 0;
   const auto num_remaining = static_cast<size_t>(
       mark_remaining(lab, &pts[0][0], object_of_label.data(), total, num_patches, obj, state.data(), &max_label));
