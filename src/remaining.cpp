@@ -50,6 +50,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <span>
 
 #include "clutterseg/curvature.hpp"
@@ -401,14 +402,18 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
     return std::abs(plane.distance({q[0], q[1], q[2]})) <= band ||
            (cylinder && cylinder->distance(Eigen::Vector3d(q[0], q[1], q[2])) <= band);
   };
+  // The mean point of a segment's pixels (all have depth: they were grown).
+  const auto centroid_of_pixels = [&](std::span<const int> seg_pixels) {
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    for (int i : seg_pixels) sum += Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
+    return Eigen::Vector3f(sum / static_cast<float>(seg_pixels.size()));
+  };
   std::vector<uchar> on_face;  // per segment pixel: on a face of the object looked at
   std::vector<int> face_pixels;  // a face's pixels in the window, for a cylinder through them
   const auto coplanar_object = [&](std::span<const int> seg_pixels, const cv::Rect& bbox, int occluder) {
     const auto object_of = [&](int patch_label) { return object_of_patch[static_cast<size_t>(patch_label - 1)] + 1; };
     if (!occlusion) return 0;
-    Eigen::Vector3f own_centroid = Eigen::Vector3f::Zero();
-    for (int i : seg_pixels) own_centroid += Eigen::Vector3f(pts[i][0], pts[i][1], pts[i][2]);
-    own_centroid /= static_cast<float>(seg_pixels.size());
+    const Eigen::Vector3f own_centroid = centroid_of_pixels(seg_pixels);
     const cv::Rect window = grown(bbox, 2 * std::max(bbox.width, bbox.height), assigned_labels);
     const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(window.area()) / kMaxVisits))));
     std::vector<std::pair<int, int>> seen;  // (visits, patch label)
@@ -663,15 +668,13 @@ cv::Mat assign_remaining(const cv::Mat& assigned_labels, const std::vector<int>&
   if (params.hidden_pairs && occlusion && params.hidden_coplanar_band > 0 && hidden_alone.size() >= 2 &&
       hidden_alone.size() <= kMaxHiddenPairs) {
     std::vector<int> root(hidden_alone.size());
-    for (size_t a = 0; a < root.size(); ++a) root[a] = static_cast<int>(a);
+    std::iota(root.begin(), root.end(), 0);
     const auto find = [&](int a) { return find_root(root, a); };
     std::vector<std::optional<Eigen::Vector3f>> centroids(hidden_alone.size());  // computed when first asked for
     const auto centroid_of = [&](size_t h) {
       if (!centroids[h]) {
         const Segment& seg = segments[hidden_alone[h].segment];
-        Eigen::Vector3f c = Eigen::Vector3f::Zero();
-        for (size_t k = seg.begin; k < seg.end; ++k) c += Eigen::Vector3f(pts[pixels[k]][0], pts[pixels[k]][1], pts[pixels[k]][2]);
-        centroids[h] = c / static_cast<float>(seg.end - seg.begin);
+        centroids[h] = centroid_of_pixels(std::span<const int>(pixels.data() + seg.begin, seg.end - seg.begin));
       }
       return *centroids[h];
     };
